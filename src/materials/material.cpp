@@ -7,6 +7,7 @@
 
 #include "core/error.hpp"
 #include "io/section.hpp"
+#include "materials/source_integrator.hpp"
 
 namespace rktsph {
 
@@ -48,69 +49,10 @@ double Material::relaxation_rate(const Sym6& /*sigma*/, const double* /*state*/)
 }
 
 SourceStats Material::advance_source(double tau, const SourceBatch& b) const {
-  const int ns = b.stress_components;
-  const int nk = state_size();
-  SourceStats stats;
-  // Scratch for the RK4 stages; a model carries at most a handful of history variables.
-  constexpr int kMaxState = 16;
-  if (nk > kMaxState) throw SolverError("material carries too many history variables");
-  for (std::size_t i = 0; i < b.count; ++i) {
-    const double* s0p = b.sigma_start + i * b.sigma_start_stride;
-    Sym6 s0{};
-    for (int c = 0; c < ns; ++c) s0[static_cast<std::size_t>(c)] = s0p[c];
-    Sym6 rate{};
-    if (b.flux_rate != nullptr) {
-      const double* rp = b.flux_rate + i * b.flux_rate_stride;
-      for (int c = 0; c < ns; ++c) rate[static_cast<std::size_t>(c)] = rp[c];
-    }
-    const double* k0 = b.state_start + static_cast<std::size_t>(nk) * i;
-    double* k_end = b.state_end + static_cast<std::size_t>(nk) * i;
-    const bool frozen = b.coupling == SourceCoupling::frozen_flux;
-    const double lam = relaxation_rate(s0, k0);
-    long substeps = std::max(1L, static_cast<long>(std::ceil(lam * tau / rk4_stability_target)));
-    if (substeps > max_substeps) {
-      throw SolverError(fmt::format(
-          "the viscoplastic source is too stiff: relaxation rate {:.3g} 1/s needs {} RK4 "
-          "sub-steps per step (limit {}); reduce the fluidity or the time step",
-          lam, substeps, max_substeps));
-    }
-    stats.max_substeps = std::max(stats.max_substeps, substeps);
-    stats.total_substeps += substeps;
-    const double dt = tau / static_cast<double>(substeps);
-    Sym6 s = s0;
-    double k[kMaxState];
-    for (int j = 0; j < nk; ++j) k[j] = k0[j];
-    Sym6 ds[4];
-    double dk[4][kMaxState];
-    Sym6 st;
-    double kt[kMaxState];
-    for (long sub = 0; sub < substeps; ++sub) {
-      // Classical RK4 stages (METHOD.md §2.2); the frozen flux rate joins the ODE when chosen.
-      const double frac[4] = {0.0, 0.5, 0.5, 1.0};
-      for (int stage = 0; stage < 4; ++stage) {
-        for (std::size_t c = 0; c < 6; ++c) st[c] = stage == 0 ? s[c] : s[c] + frac[stage] * dt * ds[stage - 1][c];
-        for (int j = 0; j < nk; ++j) kt[j] = stage == 0 ? k[j] : k[j] + frac[stage] * dt * dk[stage - 1][j];
-        source_rate(st, kt, ds[stage], dk[stage]);
-        if (frozen) {
-          for (std::size_t c = 0; c < 6; ++c) ds[stage][c] += rate[c];
-        }
-      }
-      for (std::size_t c = 0; c < 6; ++c) {
-        s[c] += dt / 6.0 * (ds[0][c] + 2.0 * ds[1][c] + 2.0 * ds[2][c] + ds[3][c]);
-      }
-      for (int j = 0; j < nk; ++j) {
-        k[j] += dt / 6.0 * (dk[0][j] + 2.0 * dk[1][j] + 2.0 * dk[2][j] + dk[3][j]);
-      }
-    }
-    double* se = b.sigma_end + i * b.sigma_end_stride;
-    for (int c = 0; c < ns; ++c) {
-      const auto cc = static_cast<std::size_t>(c);
-      // Additive form: flux increment and source increment from the same start state.
-      se[c] = frozen ? s[cc] : s[cc] + tau * rate[cc];
-    }
-    for (int j = 0; j < nk; ++j) k_end[j] = k[j];
-  }
-  return stats;
+  return detail::integrate_source_batch(
+      tau, b, state_size(),
+      [this](const Sym6& s, const double* k, Sym6& ds, double* dk) { source_rate(s, k, ds, dk); },
+      [this](const Sym6& s, const double* k) { return relaxation_rate(s, k); });
 }
 
 ElasticConstants read_elastic_constants(const io::Section& s) {

@@ -59,6 +59,7 @@ struct SourceBatch {
   std::size_t sigma_end_stride = 0;
   const double* state_start = nullptr;
   double* state_end = nullptr;
+  std::size_t state_stride = 0;  // doubles between particles' states; 0 means state_size()
   SourceCoupling coupling = SourceCoupling::additive;
 };
 
