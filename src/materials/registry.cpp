@@ -8,6 +8,7 @@
 #include "core/error.hpp"
 #include "io/section.hpp"
 #include "materials/material.hpp"
+#include "materials/perzyna_models.hpp"
 
 namespace rktsph {
 namespace {
@@ -25,6 +26,10 @@ std::unique_ptr<Material> make_elastic(const io::Section& s) {
 const std::vector<Entry>& models() {
   static const std::vector<Entry> kModels = {
       {"elastic", "isotropic linear (hypo-)elastic: E, nu, density", make_elastic},
+      {"perzyna_von_mises", "Perzyna viscoplastic von Mises with linear hardening/softening",
+       make_perzyna_von_mises},
+      {"perzyna_cam_clay", "Perzyna viscoplastic modified Cam-Clay with p_c hardening",
+       make_perzyna_cam_clay},
   };
   return kModels;
 }

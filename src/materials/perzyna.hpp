@@ -1,0 +1,110 @@
+#pragma once
+// Perzyna viscoplasticity composed of parts (METHOD.md §1.6):
+//   eps_vp_dot = gamma <Phi((F - Y)/Y)> m,   dsigma/dt = -D^e : eps_vp_dot,
+// with a yield-surface part (F, dF/dsigma, flow vector m), an overstress part (Phi) and a
+// hardening part (history variables, Y and their rates). A new surface is one small header
+// with value/gradient/flow plus one registry entry (materials/perzyna_models.cpp).
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <span>
+#include <string>
+#include <utility>
+
+#include <fmt/format.h>
+
+#include "core/error.hpp"
+#include "materials/material.hpp"
+#include "materials/overstress.hpp"
+#include "materials/source_integrator.hpp"
+#include "materials/tensor.hpp"
+
+namespace rktsph {
+
+template <class Surface, class Hardening>
+class PerzynaMaterial final : public Material {
+ public:
+  PerzynaMaterial(std::string model, ElasticConstants elastic, Surface surface,
+                  Hardening hardening, Overstress overstress, double fluidity)
+      : Material(elastic),
+        model_(std::move(model)),
+        names_(Hardening::names()),
+        surface_(surface),
+        hardening_(hardening),
+        overstress_(overstress),
+        fluidity_(fluidity) {}
+
+  std::string_view model() const override { return model_; }
+  std::span<const std::string> state_names() const override { return names_; }
+  bool has_source() const override { return true; }
+
+  void initial_state(const Sym6& sigma, double* state) const override {
+    hardening_.initial_state(surface_.value(sigma, 1.0), state);
+    const double Y = hardening_.size(state);
+    if (!(Y > 0.0)) {
+      throw InputError(fmt::format(
+          "{}: the initial stress gives a non-positive yield size {} Pa (with an OCR the "
+          "initial stress must be compressive; give p_c0 instead)",
+          model_, Y));
+    }
+  }
+
+  void source_rate(const Sym6& sigma, const double* state, Sym6& dsigma,
+                   double* dstate) const override {
+    rate(sigma, state, dsigma, dstate);
+  }
+
+  /// Linearised relaxation rate of the normalised overstress x = (F - Y)/Y along the flow
+  /// (METHOD.md §4.3): gamma Phi'(x) [dF/dsigma : D^e : m + (1 + x)|dY/d(gamma Phi)|] / Y.
+  /// von Mises, N = 1, H = 0 gives 3 G gamma / Y; Cam-Clay gives gamma K M^2/p_c on the
+  /// isotropic axis and 6 G gamma/p_c at the critical state. Zero inside the surface.
+  double relaxation_rate(const Sym6& sigma, const double* state) const override {
+    const double Y = hardening_.size(state);
+    const double x = (surface_.value(sigma, Y) - Y) / Y;
+    const double slope = overstress_.slope(x);
+    if (!(slope > 0.0)) return 0.0;
+    const Sym6 m = surface_.flow(sigma, Y);
+    const Sym6 n = surface_.gradient(sigma, Y);
+    const double stiff = std::abs(tensor::ddot(n, elastic().apply(m))) +
+                         (1.0 + x) * std::abs(hardening_.size_rate_per_flow(m, state));
+    return fluidity_ * slope * stiff / Y;
+  }
+
+  /// Fast path: the RK4 batch integrator with the non-virtual rate inlined.
+  SourceStats advance_source(double tau, const SourceBatch& batch) const override {
+    return detail::integrate_source_batch(
+        tau, batch, Hardening::kSize,
+        [this](const Sym6& s, const double* k, Sym6& ds, double* dk) { rate(s, k, ds, dk); },
+        [this](const Sym6& s, const double* k) { return relaxation_rate(s, k); });
+  }
+
+  const Surface& surface() const { return surface_; }
+  const Hardening& hardening() const { return hardening_; }
+  const Overstress& overstress() const { return overstress_; }
+  double fluidity() const { return fluidity_; }
+
+ private:
+  void rate(const Sym6& sigma, const double* state, Sym6& dsigma, double* dstate) const {
+    const double Y = hardening_.size(state);
+    const double phi = overstress_.value((surface_.value(sigma, Y) - Y) / Y);
+    if (!(phi > 0.0)) {
+      dsigma.fill(0.0);
+      for (int j = 0; j < Hardening::kSize; ++j) dstate[j] = 0.0;
+      return;
+    }
+    // eps_vp_dot in tensor components; D^e.apply gives sigma_xy = 2 G eps_xy (METHOD.md §1.6).
+    const Sym6 evp = tensor::scaled(surface_.flow(sigma, Y), fluidity_ * phi);
+    const Sym6 d = elastic().apply(evp);
+    for (std::size_t i = 0; i < 6; ++i) dsigma[i] = -d[i];
+    hardening_.rate(evp, state, dstate);
+  }
+
+  std::string model_;
+  std::array<std::string, Hardening::kSize> names_;
+  Surface surface_;
+  Hardening hardening_;
+  Overstress overstress_;
+  double fluidity_;  // gamma, 1/s
+};
+
+}  // namespace rktsph

@@ -1,0 +1,45 @@
+#pragma once
+// Small helpers on full symmetric tensors (core/types.hpp Sym6: xx, yy, zz, xy, yz, xz with
+// TENSOR shear components). A double contraction counts each shear component twice.
+#include <array>
+#include <cmath>
+
+#include "core/types.hpp"
+
+namespace rktsph::tensor {
+
+inline double trace(const Sym6& a) { return a[0] + a[1] + a[2]; }
+
+inline Sym6 deviator(const Sym6& a) {
+  const double m = trace(a) / 3.0;
+  return {a[0] - m, a[1] - m, a[2] - m, a[3], a[4], a[5]};
+}
+
+/// a : b for symmetric tensors (shear entries appear twice in the full tensor).
+inline double ddot(const Sym6& a, const Sym6& b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + 2.0 * (a[3] * b[3] + a[4] * b[4] + a[5] * b[5]);
+}
+
+inline Sym6 scaled(const Sym6& a, double c) {
+  return {c * a[0], c * a[1], c * a[2], c * a[3], c * a[4], c * a[5]};
+}
+
+/// Matrix product a·a of a symmetric tensor with itself.
+inline Sym6 square(const Sym6& a) {
+  const double xx = a[0], yy = a[1], zz = a[2], xy = a[3], yz = a[4], xz = a[5];
+  return {xx * xx + xy * xy + xz * xz, xy * xy + yy * yy + yz * yz, xz * xz + yz * yz + zz * zz,
+          xx * xy + xy * yy + xz * yz, xy * xz + yy * yz + yz * zz, xx * xz + xy * yz + xz * zz};
+}
+
+inline double determinant(const Sym6& a) {
+  const double xx = a[0], yy = a[1], zz = a[2], xy = a[3], yz = a[4], xz = a[5];
+  return xx * (yy * zz - yz * yz) - xy * (xy * zz - yz * xz) + xz * (xy * yz - yy * xz);
+}
+
+/// Equivalent strain (rate) sqrt(2/3 e:e) of the deviatoric part e (METHOD.md §1.7).
+inline double equivalent_strain(const Sym6& eps) {
+  const Sym6 e = deviator(eps);
+  return std::sqrt(2.0 / 3.0 * ddot(e, e));
+}
+
+}  // namespace rktsph::tensor
