@@ -1,0 +1,36 @@
+#pragma once
+// `rktsph material-point FILE.toml [--out DIR]`: drive one homogeneous stress point along a
+// load path (materials/material_point_path.hpp) and write DIR/path.csv, DIR/summary.json and,
+// when /usr/bin/python3 has matplotlib, DIR/path.png. Case format: docs/materials.md.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "materials/material.hpp"
+#include "materials/material_point_path.hpp"
+
+namespace rktsph {
+
+struct MaterialPointCase {
+  std::unique_ptr<Material> material;
+  Sym6 sigma0{};            // Pa, tension positive
+  LoadPath path;
+  std::string path_type;    // the [path] type key
+  std::string plot_strain;  // strain component on the plot's abscissa ("yy", "xy", ...)
+  bool plot = true;
+};
+
+/// Read and check a case file; overrides are "dotted.key=value" (a TOML value; a bare word is
+/// a string). Throws InputError naming file, line and key.
+MaterialPointCase load_material_point_case(const std::string& case_file,
+                                           const std::vector<std::string>& overrides);
+
+/// Header: t,exx,eyy,ezz,exy,sxx,syy,szz,sxy,p,q,<state names>.
+void write_path_csv(const std::string& file, const Material& material, const PathResult& result);
+
+/// The whole command. Returns the exit status: 0, 2 (input error) or 3 (solver error); the
+/// message of an error is printed to stderr.
+int run_material_point(const std::string& case_file, const std::string& out_dir,
+                       const std::vector<std::string>& overrides);
+
+}  // namespace rktsph

@@ -1,0 +1,180 @@
+#include "materials/material_point_path.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Dense>
+#include <fmt/format.h>
+
+#include "core/error.hpp"
+
+namespace rktsph {
+
+namespace {
+LoadPath strain_path(const Sym6& rate) {
+  LoadPath p;
+  p.rate = rate;
+  return p;
+}
+}  // namespace
+
+LoadPath LoadPath::drained_triaxial(double axial_rate) {
+  LoadPath p = strain_path({0.0, axial_rate, 0.0, 0.0, 0.0, 0.0});
+  p.control[0] = Control::stress;  // rate 0: constant lateral stress
+  p.control[2] = Control::stress;
+  return p;
+}
+
+LoadPath LoadPath::undrained_triaxial(double axial_rate) {
+  return strain_path({-0.5 * axial_rate, axial_rate, -0.5 * axial_rate, 0.0, 0.0, 0.0});
+}
+
+LoadPath LoadPath::oedometric(double axial_rate) {
+  return strain_path({0.0, axial_rate, 0.0, 0.0, 0.0, 0.0});
+}
+
+LoadPath LoadPath::plane_strain_compression(double axial_rate) {
+  LoadPath p = strain_path({0.0, axial_rate, 0.0, 0.0, 0.0, 0.0});
+  p.control[0] = Control::stress;
+  return p;
+}
+
+LoadPath LoadPath::simple_shear(double shear_rate) {
+  return strain_path({0.0, 0.0, 0.0, 0.5 * shear_rate, 0.0, 0.0});
+}
+
+namespace {
+
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+
+/// The mixed-control rate: given (sigma, kappa), the rates of (sigma, eps, kappa).
+class MixedRate {
+ public:
+  MixedRate(const Material& m, const LoadPath& path) : material_(m), path_(path) {
+    const ElasticConstants& el = m.elastic();
+    D_.setZero();
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) D_(i, j) = el.lambda;
+    }
+    for (int i = 0; i < 6; ++i) D_(i, i) += 2.0 * el.G;  // tensor shear: sigma_xy = 2G eps_xy
+    for (int i = 0; i < 6; ++i) {
+      (path.control[static_cast<std::size_t>(i)] == Control::stress ? S_ : E_).push_back(i);
+    }
+    const int ns = static_cast<int>(S_.size());
+    Eigen::MatrixXd Dss(ns, ns);
+    for (int a = 0; a < ns; ++a) {
+      for (int b = 0; b < ns; ++b) Dss(a, b) = D_(S_[a], S_[b]);
+    }
+    lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(Dss);
+  }
+
+  /// sigma_dot, eps_dot, kappa_dot; with_source = false gives the purely elastic rates.
+  void operator()(const Sym6& sigma, const double* k, Sym6& dsig, Sym6& deps, double* dk,
+                  bool with_source = true) const {
+    Sym6 src{};
+    if (with_source) {
+      material_.source_rate(sigma, k, src, dk);
+    } else {
+      for (int j = 0; j < material_.state_size(); ++j) dk[j] = 0.0;
+    }
+    for (int i : E_) deps[static_cast<std::size_t>(i)] = path_.rate[static_cast<std::size_t>(i)];
+    // Stress-controlled components: D_SS eps_S = sigma_dot_S - D_SE eps_E - src_S.
+    if (!S_.empty()) {
+      const int ns = static_cast<int>(S_.size());
+      Eigen::VectorXd rhs(ns);
+      for (int a = 0; a < ns; ++a) {
+        const auto ia = static_cast<std::size_t>(S_[a]);
+        double r = path_.rate[ia] - src[ia];
+        for (int j : E_) r -= D_(S_[a], j) * deps[static_cast<std::size_t>(j)];
+        rhs(a) = r;
+      }
+      const Eigen::VectorXd x = lu_.solve(rhs);
+      for (int a = 0; a < ns; ++a) deps[static_cast<std::size_t>(S_[a])] = x(a);
+    }
+    for (int i = 0; i < 6; ++i) {
+      double r = src[static_cast<std::size_t>(i)];
+      for (int j = 0; j < 6; ++j) r += D_(i, j) * deps[static_cast<std::size_t>(j)];
+      dsig[static_cast<std::size_t>(i)] = r;
+    }
+  }
+
+ private:
+  const Material& material_;
+  const LoadPath& path_;
+  Mat6 D_;
+  std::vector<int> S_, E_;
+  Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
+};
+
+bool finite(const Sym6& a) {
+  return std::all_of(a.begin(), a.end(), [](double v) { return std::isfinite(v); });
+}
+
+}  // namespace
+
+PathResult integrate_path(const Material& material, const Sym6& sigma0, const LoadPath& path) {
+  if (!(path.duration > 0.0)) throw SolverError("material point: duration must be > 0");
+  const double dt_nominal = path.dt > 0.0 ? path.dt : path.duration / 1000.0;
+  const long nsteps = std::max(1L, static_cast<long>(std::ceil(path.duration / dt_nominal - 1e-9)));
+  const int nk = material.state_size();
+  const auto unk = static_cast<std::size_t>(nk);
+  const MixedRate rate(material, path);
+
+  Sym6 sig = sigma0;
+  Sym6 eps{};
+  std::vector<double> k(unk);
+  material.initial_state(sig, k.data());
+
+  PathResult res;
+  auto record = [&](double t) { res.points.push_back({t, eps, sig, k}); };
+  record(0.0);
+
+  Sym6 ds[4], de[4], sst, dummy;
+  std::vector<std::vector<double>> dk(4, std::vector<double>(unk));
+  std::vector<double> kt(unk), kel(unk);
+  const int every = std::max(1, path.output_every);
+  double t = 0.0;
+  for (long step = 0; step < nsteps; ++step) {
+    const double dt = std::min(dt_nominal, path.duration - t);
+    // Stiffness at the start and at the elastic trial end point (METHOD.md §4.3): inside the
+    // surface the rate is 0, but the loading can carry the point outside within the step.
+    rate(sig, k.data(), ds[0], dummy, kel.data(), false);
+    for (std::size_t c = 0; c < 6; ++c) sst[c] = sig[c] + dt * ds[0][c];
+    const double lam = std::max(material.relaxation_rate(sig, k.data()),
+                                material.relaxation_rate(sst, k.data()));
+    res.max_relaxation_rate = std::max(res.max_relaxation_rate, lam);
+    const double want = std::ceil(lam * dt / path.relaxation_target);
+    if (!(want <= 1e7)) {
+      throw SolverError(fmt::format("material point: relaxation rate {:.3g} 1/s is too stiff "
+                                    "for the step {:.3g} s",
+                                    lam, dt));
+    }
+    const long nsub = std::max(1L, static_cast<long>(want));
+    const double h = dt / static_cast<double>(nsub);
+    for (long sub = 0; sub < nsub; ++sub) {
+      constexpr double kFrac[4] = {0.0, 0.5, 0.5, 1.0};
+      for (int s = 0; s < 4; ++s) {
+        for (std::size_t c = 0; c < 6; ++c) sst[c] = s == 0 ? sig[c] : sig[c] + kFrac[s] * h * ds[s - 1][c];
+        for (std::size_t j = 0; j < unk; ++j) kt[j] = s == 0 ? k[j] : k[j] + kFrac[s] * h * dk[static_cast<std::size_t>(s - 1)][j];
+        rate(sst, kt.data(), ds[s], de[s], dk[static_cast<std::size_t>(s)].data());
+      }
+      for (std::size_t c = 0; c < 6; ++c) {
+        sig[c] += h / 6.0 * (ds[0][c] + 2.0 * ds[1][c] + 2.0 * ds[2][c] + ds[3][c]);
+        eps[c] += h / 6.0 * (de[0][c] + 2.0 * de[1][c] + 2.0 * de[2][c] + de[3][c]);
+      }
+      for (std::size_t j = 0; j < unk; ++j) {
+        k[j] += h / 6.0 * (dk[0][j] + 2.0 * dk[1][j] + 2.0 * dk[2][j] + dk[3][j]);
+      }
+    }
+    res.substeps += nsub;
+    t = step + 1 == nsteps ? path.duration : t + dt;
+    if (!finite(sig) || !finite(eps)) {
+      throw SolverError(fmt::format("material point: non-finite stress at t = {:.6g} s", t));
+    }
+    if ((step + 1) % every == 0 || step + 1 == nsteps) record(t);
+  }
+  res.steps = nsteps;
+  return res;
+}
+
+}  // namespace rktsph
