@@ -1,1 +1,75 @@
-int main() { return 0; }
+// rktsph: Runge–Kutta Taylor SPH for the dynamics of dry and saturated soils.
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include "app/material_point.hpp"
+#include "app/run_case.hpp"
+#include "core/error.hpp"
+#include "materials/material.hpp"
+#include "rktsph/version.hpp"
+
+int main(int argc, char** argv) {
+  using namespace rktsph;
+  CLI::App app{
+      "rktsph - dynamics of dry and saturated soils by the Runge-Kutta Taylor SPH method.\n"
+      "Cases are TOML files (format: docs/case-format.md); results go to an output folder\n"
+      "with ParaView files (nodes.pvd, elements.pvd), probes.csv, energy.csv and summary.json.\n\n"
+      "Examples:\n"
+      "  rktsph run cases/thesis/01_elastic_bar_1d.toml\n"
+      "  rktsph run case.toml --out runs/stiff --set material.E=2.5e7 --threads 2\n"
+      "  rktsph material-point cases/material_point/cam_clay_drained_triaxial.toml\n"};
+  app.set_version_flag("--version", fmt::format("rktsph {} ({})", kVersion, kGitRevision));
+  app.require_subcommand(1);
+
+  RunOptions run;
+  auto* run_cmd = app.add_subcommand("run", "Run a case file and write its output folder");
+  run_cmd->add_option("case", run.case_file, "Case file (TOML)")->required()->check(CLI::ExistingFile);
+  run_cmd->add_option("--out,-o", run.out_dir, "Output folder (default: out/<case name>)");
+  run_cmd->add_option("--set,-s", run.overrides,
+                      "Override a case key, e.g. --set material.E=2.5e7 (repeatable; checked "
+                      "like the file)");
+  run_cmd->add_option("--threads,-j", run.threads, "Number of threads (default: all cores)")
+      ->check(CLI::NonNegativeNumber);
+  run_cmd->add_flag("--quiet,-q", run.quiet, "No progress output");
+
+  std::string mp_file, mp_out;
+  std::vector<std::string> mp_overrides;
+  auto* mp_cmd = app.add_subcommand(
+      "material-point", "Drive one material point along a stress/strain path (path.csv + plot)");
+  mp_cmd->add_option("case", mp_file, "Material-point file (TOML)")->required()->check(CLI::ExistingFile);
+  mp_cmd->add_option("--out,-o", mp_out, "Output folder (default: out/<file name>)");
+  mp_cmd->add_option("--set,-s", mp_overrides, "Override a key, e.g. --set material.fluidity=10");
+
+  auto* mat_cmd = app.add_subcommand("materials", "List the constitutive models");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 2;
+  }
+
+  try {
+    if (run_cmd->parsed()) return run_case(run);
+    if (mp_cmd->parsed()) return run_material_point(mp_file, mp_out, mp_overrides);
+    if (mat_cmd->parsed()) {
+      for (const auto& [name, description] : registered_materials()) {
+        std::cout << fmt::format("{:<22} {}\n", name, description);
+      }
+      return 0;
+    }
+  } catch (const InputError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 2;
+  } catch (const SolverError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 3;
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

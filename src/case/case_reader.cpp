@@ -1,0 +1,409 @@
+// Reading and checking a TOML case file (docs/case-format.md). Every error names the file,
+// the line and the key, and is an InputError (exit status 2).
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "case/case_setup.hpp"
+#include "core/error.hpp"
+#include "io/section.hpp"
+
+namespace rktsph {
+
+namespace {
+
+std::vector<std::string> split(const std::string& s, char sep) {
+  std::vector<std::string> out;
+  std::string cur;
+  for (char c : s) {
+    if (c == sep) {
+      out.push_back(cur);
+      cur.clear();
+    } else {
+      cur.push_back(c);
+    }
+  }
+  out.push_back(cur);
+  return out;
+}
+
+// Apply one --set key=value: the value is read as a TOML value (a bare word becomes a string).
+void apply_override(toml::table& root, const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0) {
+    throw InputError(fmt::format("--set '{}': expected key=value, e.g. --set material.E=2.5e7",
+                                 assignment));
+  }
+  const std::string key = assignment.substr(0, eq);
+  const std::string text = assignment.substr(eq + 1);
+  toml::table parsed;
+  try {
+    parsed = toml::parse("v = " + text);
+  } catch (const toml::parse_error&) {
+    parsed = toml::table{{"v", text}};
+  }
+  const auto parts = split(key, '.');
+  toml::node* cur = &root;
+  for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
+    const std::string& p = parts[i];
+    if (auto* t = cur->as_table()) {
+      toml::node* next = t->get(p);
+      if (next == nullptr) {
+        t->insert(p, toml::table{});
+        next = t->get(p);
+      }
+      cur = next;
+    } else if (auto* a = cur->as_array()) {
+      std::size_t idx = 0;
+      try {
+        idx = std::stoul(p);
+      } catch (...) {
+        throw InputError(fmt::format("--set '{}': '{}' indexes an array and must be a number",
+                                     assignment, p));
+      }
+      if (idx >= a->size()) {
+        throw InputError(fmt::format("--set '{}': index {} is past the end of the array ({} "
+                                     "entries)", assignment, idx, a->size()));
+      }
+      cur = a->get(idx);
+    } else {
+      throw InputError(fmt::format("--set '{}': '{}' is not a table", assignment, p));
+    }
+  }
+  toml::table* parent = cur->as_table();
+  if (parent == nullptr) {
+    throw InputError(fmt::format("--set '{}': the parent of '{}' is not a table", assignment,
+                                 parts.back()));
+  }
+  parent->insert_or_assign(parts.back(), *parsed.get("v"));
+}
+
+template <int Dim>
+Vec<Dim> read_vector(const io::Section& s, std::string_view key) {
+  const auto v = s.numbers(key);
+  if (static_cast<int>(v.size()) != Dim) {
+    s.fail(key, fmt::format("must have {} component{} for a {}D case, got {}", Dim,
+                            Dim > 1 ? "s" : "", Dim, v.size()));
+  }
+  Vec<Dim> out;
+  for (int d = 0; d < Dim; ++d) out[d] = v[static_cast<std::size_t>(d)];
+  return out;
+}
+
+int axis_of(std::string_view name) {
+  for (std::size_t d = 0; d < 3; ++d) {
+    if (kAxisNames[d] == name) return static_cast<int>(d);
+  }
+  return -1;
+}
+
+template <int Dim>
+int function_index(const CaseSetup<Dim>& c, const io::Section& s, std::string_view key) {
+  if (!s.has(key)) {
+    s.string(key, "");  // mark as read
+    return -1;
+  }
+  const std::string name = s.string(key);
+  for (std::size_t i = 0; i < c.function_names.size(); ++i) {
+    if (c.function_names[i] == name) return static_cast<int>(i);
+  }
+  s.fail(key, fmt::format("no time function named '{}' (defined: {})", name,
+                          c.function_names.empty() ? std::string("none")
+                                                   : fmt::format("{}", fmt::join(c.function_names, ", "))));
+}
+
+int material_index(const std::vector<std::string>& names, const io::Section& s,
+                   std::string_view key) {
+  if (!s.has(key)) {
+    s.string(key, "");
+    if (names.size() == 1) return 0;
+    s.fail(key, fmt::format("several materials are defined ({}); name the block's material",
+                            fmt::join(names, ", ")));
+  }
+  const std::string name = s.string(key);
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (names[i] == name) return static_cast<int>(i);
+  }
+  s.fail(key, fmt::format("no material named '{}' (defined: {})", name, fmt::join(names, ", ")));
+}
+
+}  // namespace
+
+CaseDocument load_case_document(const std::string& file, const std::vector<std::string>& overrides) {
+  CaseDocument doc;
+  doc.file = file;
+  doc.file_label = std::make_shared<const std::string>(file);
+  std::ifstream in(file);
+  if (!in) throw InputError(fmt::format("{}: cannot open the case file", file));
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  try {
+    doc.table = toml::parse(buffer.str(), file);
+  } catch (const toml::parse_error& e) {
+    throw InputError(fmt::format("{}, line {}: not valid TOML: {}", file,
+                                 e.source().begin.line, e.description()));
+  }
+  for (const auto& o : overrides) apply_override(doc.table, o);
+  return doc;
+}
+
+int case_dimension(const CaseDocument& doc) {
+  io::Section root(doc.table, "", doc.file_label);
+  const io::Section g = root.table("geometry");
+  const auto d = g.integer("dimension");
+  if (d != 1 && d != 2) {
+    g.fail("dimension", fmt::format("must be 1 or 2 (3D is not available yet), got {}", d));
+  }
+  return static_cast<int>(d);
+}
+
+template <int Dim>
+CaseSetup<Dim> read_case(const CaseDocument& doc) {
+  CaseSetup<Dim> c;
+  c.file = doc.file;
+  io::Section root(doc.table, "", doc.file_label);
+  c.title = root.string("title", "");
+
+  // ---- time functions (read first: other tables refer to them by name)
+  if (auto fs = root.optional_table("functions")) {
+    for (const std::string& name : fs->keys()) {
+      c.function_names.push_back(name);
+      c.functions.push_back(TimeFunction::read(fs->table(name)));
+    }
+    fs->finish();
+  }
+
+  // ---- materials: one [material] table or named [materials.NAME] tables
+  const bool single = root.has("material");
+  const bool named = root.has("materials");
+  if (single && named) root.fail("materials", "give either [material] or [materials.NAME], not both");
+  if (!single && !named) root.fail("material", "missing: the case needs a [material] table");
+  if (single) {
+    const io::Section m = root.table("material");
+    c.material_names.push_back("material");
+    c.materials.push_back(create_material(m));
+    m.finish();
+  } else {
+    const io::Section ms = root.table("materials");
+    for (const std::string& name : ms.keys()) {
+      const io::Section m = ms.table(name);
+      c.material_names.push_back(name);
+      c.materials.push_back(create_material(m));
+      m.finish();
+    }
+    ms.finish();
+  }
+
+  // ---- geometry
+  {
+    const io::Section g = root.table("geometry");
+    g.integer("dimension");
+    c.dx = g.positive("spacing");
+    if (g.has("origin")) c.origin = read_vector<Dim>(g, "origin");
+    else g.number("origin", 0.0);
+    const auto blocks = g.tables("block");
+    if (blocks.empty()) g.fail("block", "missing: the geometry needs at least one [[geometry.block]]");
+    for (const io::Section& b : blocks) {
+      Block<Dim> blk;
+      blk.min = read_vector<Dim>(b, "min");
+      blk.max = read_vector<Dim>(b, "max");
+      blk.material = material_index(c.material_names, b, "material");
+      blk.label = b.where();
+      b.finish();
+      c.blocks.push_back(blk);
+    }
+    g.finish();
+  }
+
+  // ---- kernel
+  if (auto k = root.optional_table("kernel")) {
+    const std::string type = k->string("type", "cubic_spline");
+    if (type != "cubic_spline") k->fail("type", fmt::format("unknown kernel '{}' (known: cubic_spline)", type));
+    c.h_over_dx = k->positive("h_over_dx", 1.2);
+    k->require(c.h_over_dx >= 0.6 && c.h_over_dx <= 3.0, "h_over_dx",
+               fmt::format("must lie in [0.6, 3] (a smaller support leaves particles without "
+                           "neighbours), got {}", c.h_over_dx));
+    k->finish();
+  }
+
+  // ---- body force and damping
+  if (auto b = root.optional_table("body_force")) {
+    c.gravity = read_vector<Dim>(*b, "gravity");
+    c.gravity_function = function_index(c, *b, "function");
+    b->finish();
+  }
+  if (auto d = root.optional_table("damping")) {
+    c.damping = d->non_negative("coefficient", 0.0);
+    c.damping_until = d->non_negative("until", std::numeric_limits<double>::infinity());
+    d->finish();
+  }
+
+  // ---- boundary conditions
+  for (const io::Section& b : root.tables("boundary")) {
+    BoundarySpec<Dim> spec;
+    spec.name = b.string("name", b.path());
+    spec.where = b.where();
+    bool any_axis = false;
+    for (int d = 0; d < Dim; ++d) {
+      const std::string axis(kAxisNames[static_cast<std::size_t>(d)]);
+      if (!b.has(axis)) {
+        b.number(axis, 0.0);
+        continue;
+      }
+      const auto range = b.numbers(axis);
+      if (range.size() != 2 || range[1] < range[0]) {
+        b.fail(axis, "must be a range [min, max] in m with min <= max (use [a, a] for a plane)");
+      }
+      spec.region.lo[static_cast<std::size_t>(d)] = range[0];
+      spec.region.hi[static_cast<std::size_t>(d)] = range[1];
+      spec.region.bounded[static_cast<std::size_t>(d)] = true;
+      any_axis = true;
+    }
+    if (!any_axis) {
+      b.fail("", fmt::format("selects no region: give at least one of {} as [min, max]",
+                             Dim == 1 ? "x" : "x, y"));
+    }
+    if (auto v = b.optional_table("velocity")) {
+      for (const std::string& axis : v->keys()) {
+        const int a = axis_of(axis);
+        if (a < 0 || a >= Dim) {
+          v->fail(axis, fmt::format("unknown velocity component (a {}D case has: {})", Dim,
+                                    Dim == 1 ? "x" : "x, y"));
+        }
+        spec.velocity.emplace_back(a, v->number(axis));
+      }
+      v->finish();
+    }
+    if (auto st = b.optional_table("stress")) {
+      for (const std::string& comp : st->keys()) {
+        // Only the components that act on a face of the body can be prescribed.
+        const bool allowed = comp == "xx" || (Dim >= 2 && (comp == "yy" || comp == "xy"));
+        if (!allowed) {
+          st->fail(comp, fmt::format("not a stress component that can be prescribed in {}D "
+                                     "(use {})",
+                                     Dim, Dim == 1 ? "xx" : "xx, yy, xy"));
+        }
+        int slot = -1;
+        for (std::size_t i = 0; i < 6; ++i) {
+          if (kStressComponentNames[i] == comp) slot = stress_slot<Dim>(static_cast<StressComponent>(i));
+        }
+        spec.stress.emplace_back(slot, st->number(comp));
+      }
+      st->finish();
+    }
+    if (spec.velocity.empty() && spec.stress.empty()) {
+      b.fail("", "prescribes nothing: give a velocity = {...} or stress = {...} table");
+    }
+    spec.function = function_index(c, b, "function");
+    b.finish();
+    c.boundaries.push_back(std::move(spec));
+  }
+
+  // ---- initial state
+  if (auto is = root.optional_table("initial_stress")) {
+    const std::string type = is->string("type", "zero");
+    if (type == "zero") {
+      c.initial_stress = InitialStressKind::zero;
+    } else if (type == "geostatic") {
+      c.initial_stress = InitialStressKind::geostatic;
+      if (is->has("K0")) {
+        const double k0 = is->number("K0");
+        is->require(k0 > 0.0 && k0 < 10.0, "K0", fmt::format("must lie in (0, 10), got {}", k0));
+        c.k0 = k0;
+      } else {
+        is->number("K0", 0.0);
+      }
+      if (is->has("surface")) c.surface_level = is->number("surface");
+      else is->number("surface", 0.0);
+      if (c.gravity.norm() == 0.0) {
+        is->fail("type", "a geostatic initial stress needs [body_force] gravity");
+      }
+    } else {
+      is->fail("type", fmt::format("unknown initial stress '{}' (known: zero, geostatic)", type));
+    }
+    is->finish();
+  }
+  if (auto iv = root.optional_table("initial_velocity")) {
+    c.initial_velocity = read_vector<Dim>(*iv, "velocity");
+    iv->finish();
+  }
+
+  // ---- time
+  {
+    const io::Section t = root.table("time");
+    c.end_time = t.positive("end");
+    const bool has_cfl = t.has("cfl"), has_dt = t.has("dt");
+    if (has_cfl && has_dt) t.fail("dt", "give either cfl or dt, not both");
+    if (has_dt) {
+      c.dt = t.positive("dt");
+      t.number("cfl", 0.0);
+    } else {
+      c.cfl = t.positive("cfl", 0.5);
+      t.number("dt", 0.0);
+    }
+    t.finish();
+  }
+
+  // ---- solver
+  if (auto s = root.optional_table("solver")) {
+    const std::string version = s->string("version", "v1");
+    if (version != "v1") {
+      s->fail("version", fmt::format("unknown solver version '{}' (available: v1)", version));
+    }
+    const std::string scheme = s->string("scheme", "staggered");
+    if (scheme == "staggered") c.scheme = Scheme::staggered;
+    else if (scheme == "collocated") c.scheme = Scheme::collocated;
+    else s->fail("scheme", fmt::format("unknown scheme '{}' (known: staggered, collocated)", scheme));
+    c.filter = s->boolean("filter", true);
+    c.filter_strength = s->number("filter_strength", 0.5);
+    s->require(c.filter_strength > 0.0 && c.filter_strength <= 1.0, "filter_strength",
+               fmt::format("must lie in (0, 1], got {}", c.filter_strength));
+    const std::string coupling = s->string("source_coupling", "additive");
+    if (coupling == "additive") c.coupling = SourceCoupling::additive;
+    else if (coupling == "frozen_flux") c.coupling = SourceCoupling::frozen_flux;
+    else s->fail("source_coupling", fmt::format("unknown source coupling '{}' (known: additive, frozen_flux)", coupling));
+    s->finish();
+  }
+
+  // ---- output and probes
+  if (auto o = root.optional_table("output")) {
+    c.output_interval = o->non_negative("interval", 0.0);
+    if (o->has("times")) {
+      c.output_times = o->numbers("times");
+      std::sort(c.output_times.begin(), c.output_times.end());
+    } else {
+      o->number("times", 0.0);
+    }
+    c.output_elements = o->boolean("elements", true);
+    c.probe_every = static_cast<int>(o->integer("probe_every", 1));
+    o->require(c.probe_every >= 1, "probe_every", "must be >= 1");
+    o->finish();
+  }
+  for (const io::Section& p : root.tables("probe")) {
+    ProbeSpec spec;
+    spec.name = p.string("name");
+    spec.where = p.where("position");
+    spec.position = p.numbers("position");
+    if (static_cast<int>(spec.position.size()) != Dim) {
+      p.fail("position", fmt::format("must have {} coordinate{} for a {}D case", Dim, Dim > 1 ? "s" : "", Dim));
+    }
+    spec.fields = p.strings("fields");
+    p.require(!spec.fields.empty(), "fields", "must name at least one field");
+    for (const auto& other : c.probes) {
+      if (other.name == spec.name) p.fail("name", fmt::format("probe name '{}' is used twice", spec.name));
+    }
+    p.finish();
+    c.probes.push_back(std::move(spec));
+  }
+  root.finish();
+  return c;
+}
+
+template CaseSetup<1> read_case<1>(const CaseDocument&);
+template CaseSetup<2> read_case<2>(const CaseDocument&);
+
+}  // namespace rktsph

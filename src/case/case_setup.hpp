@@ -1,0 +1,122 @@
+#pragma once
+// A case as the solver sees it, after the TOML file has been read and checked
+// (case/case_reader.cpp). Every key is documented in docs/case-format.md.
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <toml++/toml.h>
+
+#include "bc/time_function.hpp"
+#include "core/types.hpp"
+#include "geometry/particles.hpp"
+#include "materials/material.hpp"
+
+namespace rktsph {
+
+/// Nodes selected by an axis-aligned box; an axis left open selects everything along it.
+template <int Dim>
+struct Region {
+  std::array<double, Dim> lo{};
+  std::array<double, Dim> hi{};
+  std::array<bool, Dim> bounded{};
+  bool contains(const Vec<Dim>& x, double tol) const {
+    for (std::size_t d = 0; d < Dim; ++d) {
+      if (bounded[d] && (x[static_cast<int>(d)] < lo[d] - tol || x[static_cast<int>(d)] > hi[d] + tol)) return false;
+    }
+    return true;
+  }
+};
+
+template <int Dim>
+struct BoundarySpec {
+  std::string name;
+  std::string where;  // "case.toml, line 12" for error messages
+  Region<Dim> region;
+  std::vector<std::pair<int, double>> velocity;  // (axis, m/s)
+  std::vector<std::pair<int, double>> stress;    // (stress slot, Pa)
+  int function = -1;                              // index into CaseSetup::functions, -1 = 1
+};
+
+struct ProbeSpec {
+  std::string name;
+  std::string where;
+  std::vector<double> position;
+  std::vector<std::string> fields;
+};
+
+enum class InitialStressKind { zero, geostatic };
+enum class Scheme { staggered, collocated };
+
+template <int Dim>
+struct CaseSetup {
+  std::string file;
+  std::string title;
+
+  // materials
+  std::vector<std::string> material_names;
+  std::vector<std::unique_ptr<Material>> materials;
+
+  // geometry
+  double dx = 0.0;
+  Vec<Dim> origin = Vec<Dim>::Zero();
+  std::vector<Block<Dim>> blocks;
+
+  // kernel
+  double h_over_dx = 1.2;
+
+  // loads
+  Vec<Dim> gravity = Vec<Dim>::Zero();  // m/s^2
+  int gravity_function = -1;
+  double damping = 0.0;        // 1/s, velocity damping source -c_d v (METHOD.md §4.2)
+  double damping_until = 0.0;  // s: damping switched off from this time on
+  std::vector<BoundarySpec<Dim>> boundaries;
+
+  // initial state
+  InitialStressKind initial_stress = InitialStressKind::zero;
+  std::optional<double> k0;            // geostatic lateral coefficient; default nu/(1-nu)
+  std::optional<double> surface_level;  // geostatic ground surface (vertical axis = last axis)
+  Vec<Dim> initial_velocity = Vec<Dim>::Zero();
+
+  // time
+  double end_time = 0.0;
+  std::optional<double> cfl;
+  std::optional<double> dt;
+
+  // solver
+  Scheme scheme = Scheme::staggered;
+  bool filter = true;
+  double filter_strength = 0.5;
+  SourceCoupling coupling = SourceCoupling::additive;
+
+  // output
+  double output_interval = 0.0;     // s; 0 = first and last state only
+  std::vector<double> output_times;  // s; extra snapshots
+  bool output_elements = true;
+  int probe_every = 1;
+  std::vector<ProbeSpec> probes;
+
+  std::vector<std::string> function_names;
+  std::vector<TimeFunction> functions;
+  double function_value(int index, double t) const {
+    return index < 0 ? 1.0 : functions[static_cast<std::size_t>(index)](t);
+  }
+};
+
+/// A TOML case file, parsed, with the command-line overrides (--set key=value) applied.
+struct CaseDocument {
+  std::string file;
+  std::shared_ptr<const std::string> file_label;
+  toml::table table;
+};
+
+CaseDocument load_case_document(const std::string& file, const std::vector<std::string>& overrides);
+/// The dimension of space of a case (geometry.dimension), checked.
+int case_dimension(const CaseDocument& doc);
+
+template <int Dim>
+CaseSetup<Dim> read_case(const CaseDocument& doc);
+
+}  // namespace rktsph

@@ -1,0 +1,57 @@
+#pragma once
+// Cubic B-spline kernel of Monaghan & Lattanzio (METHOD.md §3.1), support radius 2h.
+#include <cmath>
+#include <numbers>
+
+#include "core/types.hpp"
+
+namespace rktsph {
+
+template <int Dim>
+class CubicSplineKernel {
+ public:
+  explicit CubicSplineKernel(double h) : h_(h), alpha_(normalisation(h)) {}
+
+  double h() const { return h_; }
+  double support_radius() const { return 2.0 * h_; }
+
+  /// W(r, h) (METHOD.md §3.1).
+  double value(double r) const {
+    const double q = r / h_;
+    if (q < 1.0) return alpha_ * (2.0 / 3.0 - q * q + 0.5 * q * q * q);
+    if (q < 2.0) {
+      const double t = 2.0 - q;
+      return alpha_ * t * t * t / 6.0;
+    }
+    return 0.0;
+  }
+
+  /// dW/dr (METHOD.md §3.1).
+  double derivative(double r) const {
+    const double q = r / h_;
+    if (q < 1.0) return alpha_ / h_ * (-2.0 * q + 1.5 * q * q);
+    if (q < 2.0) {
+      const double t = 2.0 - q;
+      return -alpha_ / h_ * 0.5 * t * t;
+    }
+    return 0.0;
+  }
+
+  /// grad_a W_ab = W'(r) (x_a - x_b) / r, with x_ab = x_a - x_b.
+  Vec<Dim> gradient(const Vec<Dim>& x_ab) const {
+    const double r = x_ab.norm();
+    if (r <= 0.0) return Vec<Dim>::Zero();
+    return derivative(r) / r * x_ab;
+  }
+
+ private:
+  static double normalisation(double h) {
+    if constexpr (Dim == 1) return 1.0 / h;
+    if constexpr (Dim == 2) return 15.0 / (7.0 * std::numbers::pi * h * h);
+    return 3.0 / (2.0 * std::numbers::pi * h * h * h);
+  }
+  double h_;
+  double alpha_;
+};
+
+}  // namespace rktsph

@@ -1,0 +1,601 @@
+#include "solvers/staggered_solver.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "core/error.hpp"
+
+namespace rktsph {
+
+namespace {
+
+// Stress slot of the tensor component (k, d) in the per-dimension storage (core/types.hpp).
+template <int Dim>
+constexpr int slot(int k, int d) {
+  if (k == d) return k;
+  const int lo = std::min(k, d), hi = std::max(k, d);
+  if (lo == 0 && hi == 1) return 3;
+  if (lo == 1 && hi == 2) return 4;
+  return 5;
+}
+
+// Increment of the velocity source dv/dt = b - c_d v over tau, integrated exactly (the limit
+// the RK4 of METHOD.md §2.2 approximates; b is taken at the interval's midpoint).
+inline double velocity_source(double v0, double b, double cd, double tau) {
+  if (cd == 0.0) return b * tau;
+  return (b - cd * v0) * (-std::expm1(-cd * tau)) / cd;
+}
+
+// Flux rates at a point from the gradients of the state (METHOD.md §1.2):
+//   dv_i/dt   = (1/rho) d sigma_ij / dx_j
+//   dsigma/dt = lambda tr(d) 1 + 2 G d,  d = sym grad v
+// grad[d][c] is the derivative along axis d of state component c.
+template <int Dim>
+inline void flux_rates(const double (&grad)[Dim][kStateComponents<Dim>], double inv_rho,
+                       double lambda, double G, double* dv, double* dsig) {
+  for (int i = 0; i < Dim; ++i) {
+    double div = 0.0;
+    for (int d = 0; d < Dim; ++d) div += grad[d][Dim + slot<Dim>(i, d)];
+    dv[i] = div * inv_rho;
+  }
+  double tr = 0.0;
+  for (int k = 0; k < Dim; ++k) tr += grad[k][k];
+  for (int n = 0; n < 3; ++n) dsig[n] = lambda * tr + (n < Dim ? 2.0 * G * grad[n][n] : 0.0);
+  for (int k = 0; k < Dim; ++k) {
+    for (int d = k + 1; d < Dim; ++d) dsig[slot<Dim>(k, d)] = G * (grad[d][k] + grad[k][d]);
+  }
+}
+
+constexpr Index kReductionBlock = 4096;  // fixed blocks: sums independent of the thread count
+
+}  // namespace
+
+template <int Dim>
+StaggeredSolver<Dim>::StaggeredSolver(CaseSetup<Dim>& setup)
+    : setup_(setup), kernel_(setup.h_over_dx * setup.dx) {
+  materials_ = std::move(setup.materials);
+  std::vector<double> densities;
+  for (const auto& m : materials_) {
+    densities.push_back(m->density());
+    lambda_.push_back(m->elastic().lambda);
+    shear_.push_back(m->elastic().G);
+    c_max_ = std::max(c_max_, m->elastic().p_wave_speed());
+    any_source_ = any_source_ || m->has_source();
+  }
+  disc_ = discretise<Dim>(setup.blocks, setup.dx, setup.origin, densities);
+  if (setup.scheme == Scheme::collocated) {
+    // Single-set comparison scheme: the half-step lives on the nodes themselves.
+    disc_.elements = disc_.nodes;
+  }
+
+  // Time step from the wave speed (METHOD.md §4.3 and §0.3 item 4).
+  constexpr double kMaxCfl = 1.3;
+  if (setup.dt) {
+    dt_ = *setup.dt;
+    cfl_ = dt_ * c_max_ / setup.dx;
+  } else {
+    cfl_ = *setup.cfl;
+    dt_ = cfl_ * setup.dx / c_max_;
+  }
+  if (cfl_ > kMaxCfl) {
+    throw InputError(fmt::format(
+        "{}, key 'time.{}': the Courant number c dt/dx = {:.3f} exceeds {} (c = {:.4g} m/s, "
+        "dx = {} m); the scheme is unstable beyond it (METHOD.md §0.3 item 4)",
+        setup.file, setup.dt ? "dt" : "cfl", cfl_, kMaxCfl, c_max_, setup.dx));
+  }
+
+  // Operators, built once: particles do not move in V1.
+  op_en_ = build_corrected_operator<Dim>(disc_.elements.position, disc_.nodes, kernel_);
+  op_ne_ = build_corrected_operator<Dim>(disc_.nodes.position, disc_.elements, kernel_);
+
+  // History variables: the union of the names of all materials.
+  for (const auto& m : materials_) {
+    state_stride_ = std::max(state_stride_, m->state_size());
+    for (const auto& n : m->state_names()) {
+      if (std::find(history_names_.begin(), history_names_.end(), n) == history_names_.end()) {
+        history_names_.push_back(n);
+      }
+    }
+  }
+  for (const auto& m : materials_) {
+    std::vector<int> slots(history_names_.size(), -1);
+    const auto names = m->state_names();
+    for (std::size_t i = 0; i < history_names_.size(); ++i) {
+      for (std::size_t j = 0; j < names.size(); ++j) {
+        if (names[j] == history_names_[i]) slots[i] = static_cast<int>(j);
+      }
+    }
+    history_slot_.push_back(std::move(slots));
+  }
+
+  const auto nn = static_cast<std::size_t>(disc_.nodes.size());
+  const auto ne = static_cast<std::size_t>(disc_.elements.size());
+  node_phi_.assign(nn * NV, 0.0);
+  elem_phi_.assign(ne * NV, 0.0);
+  node_u_.assign(nn * Dim, 0.0);
+  node_state_.assign(nn * static_cast<std::size_t>(state_stride_), 0.0);
+  elem_state_.assign(ne * static_cast<std::size_t>(state_stride_), 0.0);
+  v_prev_.assign(nn * Dim, 0.0);
+  filter_elem_.assign(ne * Dim, 0.0);
+  filter_node_.assign(nn * Dim, 0.0);
+  if (any_source_) {
+    src_sigma_start_.assign(std::max(nn, ne) * NS, 0.0);
+    src_rate_.assign(std::max(nn, ne) * NS, 0.0);
+  }
+  block_sums_.assign(((nn + kReductionBlock - 1) / kReductionBlock) * (Dim + 2), 0.0);
+
+  // Runs of particles whose material has a source, cut into chunks for the threads.
+  auto make_runs = [&](const ParticleSet<Dim>& set) {
+    std::vector<std::array<Index, 3>> runs;
+    constexpr Index kChunk = 512;
+    Index i = 0;
+    while (i < set.size()) {
+      const int m = set.material[static_cast<std::size_t>(i)];
+      Index j = i;
+      while (j < set.size() && set.material[static_cast<std::size_t>(j)] == m && j - i < kChunk) ++j;
+      if (materials_[static_cast<std::size_t>(m)]->has_source()) runs.push_back({m, i, j});
+      i = j;
+    }
+    return runs;
+  };
+  node_runs_ = make_runs(disc_.nodes);
+  elem_runs_ = make_runs(disc_.elements);
+
+  build_constraints();
+  set_initial_state();
+}
+
+template <int Dim>
+void StaggeredSolver<Dim>::build_constraints() {
+  const auto nn = static_cast<std::size_t>(disc_.nodes.size());
+  std::vector<std::vector<NodalConstraint>> per_node(nn);
+  std::vector<std::uint8_t> velocity_set(nn, 0);
+  const double tol = 1e-6 * setup_.dx + 1e-12;
+
+  auto set = [](std::vector<NodalConstraint>& list, NodalConstraint c) {
+    for (auto& existing : list) {
+      if (existing.component == c.component) {
+        existing = c;  // a later [[boundary]] overrides an earlier one on the same component
+        return;
+      }
+    }
+    list.push_back(c);
+  };
+
+  for (const auto& spec : setup_.boundaries) {
+    std::size_t selected = 0;
+    for (std::size_t i = 0; i < nn; ++i) {
+      if (!spec.region.contains(disc_.nodes.position[i], tol)) continue;
+      ++selected;
+      for (const auto& [axis, value] : spec.velocity) {
+        set(per_node[i], {axis, value, spec.function});
+        velocity_set[i] = static_cast<std::uint8_t>(velocity_set[i] | (1u << axis));
+      }
+      for (const auto& [s, value] : spec.stress) set(per_node[i], {Dim + s, value, spec.function});
+    }
+    if (selected == 0) {
+      throw InputError(fmt::format("{}: boundary '{}' selects no node; check its ranges "
+                                   "against the geometry",
+                                   spec.where, spec.name));
+    }
+  }
+
+  // Faces of the body are traction-free unless something else is prescribed (METHOD.md §4.1):
+  // on a face with normal e_d, sigma_kd = 0 for every k whose velocity is free. Where v_k is
+  // prescribed, the traction component sigma_kd is a reaction and is not prescribed.
+  for (std::size_t i = 0; i < nn; ++i) {
+    const std::uint8_t faces = disc_.boundary.faces[i];
+    auto& list = per_node[i];
+    for (int d = 0; d < Dim; ++d) {
+      if ((faces & (3u << (2 * d))) == 0) continue;
+      for (int k = 0; k < Dim; ++k) {
+        const int comp = Dim + slot<Dim>(k, d);
+        const bool v_fixed = (velocity_set[i] >> k) & 1u;
+        auto it = std::find_if(list.begin(), list.end(),
+                               [&](const NodalConstraint& c) { return c.component == comp; });
+        if (v_fixed) {
+          if (it != list.end()) list.erase(it);
+        } else if (it == list.end()) {
+          list.push_back({comp, 0.0, -1});
+        }
+      }
+    }
+  }
+
+  constraint_row_.assign(nn + 1, 0);
+  diff_row_of_node_.assign(nn, -1);
+  std::vector<Index> constrained;
+  for (std::size_t i = 0; i < nn; ++i) {
+    std::sort(per_node[i].begin(), per_node[i].end(),
+              [](const auto& a, const auto& b) { return a.component < b.component; });
+    for (const auto& c : per_node[i]) constraints_.push_back(c);
+    constraint_row_[i + 1] = static_cast<Index>(constraints_.size());
+    if (!per_node[i].empty()) {
+      diff_row_of_node_[i] = static_cast<Index>(constrained.size());
+      constrained.push_back(static_cast<Index>(i));
+    }
+    if (disc_.boundary.faces[i] != 0) boundary_nodes_.push_back(static_cast<Index>(i));
+  }
+  diff_ne_ = build_difference_gradient<Dim>(disc_.nodes.position, constrained, disc_.elements,
+                                            kernel_);
+}
+
+template <int Dim>
+void StaggeredSolver<Dim>::set_initial_state() {
+  const auto nn = static_cast<std::size_t>(disc_.nodes.size());
+  const int vertical = Dim - 1;  // the last axis points up
+  const double g = setup_.gravity.norm();
+  double surface = -std::numeric_limits<double>::infinity();
+  for (const auto& x : disc_.nodes.position) surface = std::max(surface, x[vertical]);
+  if (setup_.surface_level) surface = *setup_.surface_level;
+  for (std::size_t i = 0; i < nn; ++i) {
+    double* phi = &node_phi_[i * NV];
+    for (int d = 0; d < Dim; ++d) phi[d] = setup_.initial_velocity[d];
+    const auto m = static_cast<std::size_t>(disc_.nodes.material[i]);
+    if (setup_.initial_stress == InitialStressKind::geostatic) {
+      // METHOD.md §4.2 option A: sigma_v = -rho g (H - z), lateral = K0 sigma_v.
+      const double nu = materials_[m]->elastic().nu;
+      const double k0 = setup_.k0.value_or(nu / (1.0 - nu));
+      const double sv = -disc_.nodes.density[i] * g * (surface - disc_.nodes.position[i][vertical]);
+      for (int n = 0; n < 3; ++n) phi[Dim + n] = (n == vertical ? 1.0 : k0) * sv;
+    }
+    if (state_stride_ > 0) {
+      materials_[m]->initial_state(to_sym6<Dim>(phi + Dim),
+                                   &node_state_[i * static_cast<std::size_t>(state_stride_)]);
+    }
+  }
+  apply_constraints(0.0);
+  initial_strain_ = energy().strain;
+  last_power_ = boundary_power();
+  double momentum[Dim] = {};
+  double mv2 = 0.0;
+  for (std::size_t i = 0; i < nn; ++i) {
+    const double m = disc_.nodes.mass(static_cast<Index>(i));
+    for (int d = 0; d < Dim; ++d) {
+      momentum[d] += m * node_phi_[i * NV + static_cast<std::size_t>(d)];
+      mv2 += m * node_phi_[i * NV + static_cast<std::size_t>(d)] * node_phi_[i * NV + static_cast<std::size_t>(d)];
+    }
+  }
+  const double fb = setup_.function_value(setup_.gravity_function, 0.0);
+  for (int d = 0; d < Dim; ++d) last_power_ += fb * setup_.gravity[d] * momentum[d];
+  last_damping_power_ = (setup_.damping > 0.0 && 0.0 < setup_.damping_until) ? setup_.damping * mv2 : 0.0;
+}
+
+template <int Dim>
+void StaggeredSolver<Dim>::apply_constraints(double t) {
+  const auto nn = static_cast<Index>(disc_.nodes.size());
+  for (Index i = 0; i < nn; ++i) {
+    for (Index k = constraint_row_[static_cast<std::size_t>(i)]; k < constraint_row_[static_cast<std::size_t>(i) + 1]; ++k) {
+      const NodalConstraint& c = constraints_[static_cast<std::size_t>(k)];
+      node_phi_[static_cast<std::size_t>(i) * NV + static_cast<std::size_t>(c.component)] =
+          c.value * setup_.function_value(c.function, t);
+    }
+  }
+}
+
+template <int Dim>
+void StaggeredSolver<Dim>::integrate_sources(double tau, bool on_elements) {
+  const auto& runs = on_elements ? elem_runs_ : node_runs_;
+  std::vector<double>& phi = on_elements ? elem_phi_ : node_phi_;
+  std::vector<double>& state = on_elements ? elem_state_ : node_state_;
+  long max_sub = max_substeps_;
+#pragma omp parallel for schedule(dynamic) reduction(max : max_sub)
+  for (std::size_t r = 0; r < runs.size(); ++r) {
+    const auto [m, begin, end] = runs[r];
+    const auto b0 = static_cast<std::size_t>(begin);
+    SourceBatch batch;
+    batch.count = static_cast<std::size_t>(end - begin);
+    batch.stress_components = NS;
+    batch.sigma_start = &src_sigma_start_[b0 * NS];
+    batch.sigma_start_stride = NS;
+    batch.flux_rate = &src_rate_[b0 * NS];
+    batch.flux_rate_stride = NS;
+    batch.sigma_end = &phi[b0 * NV + Dim];
+    batch.sigma_end_stride = NV;
+    batch.state_start = state.data() + b0 * static_cast<std::size_t>(state_stride_);
+    batch.state_end = state.data() + b0 * static_cast<std::size_t>(state_stride_);
+    batch.state_stride = static_cast<std::size_t>(state_stride_);
+    batch.coupling = setup_.coupling;
+    const SourceStats stats = materials_[static_cast<std::size_t>(m)]->advance_source(tau, batch);
+    max_sub = std::max(max_sub, stats.max_substeps);
+  }
+  max_substeps_ = max_sub;
+}
+
+// Step 1 (METHOD.md §5.1): nodes -> elements, t^n -> t^{n+1/2}.
+template <int Dim>
+void StaggeredSolver<Dim>::step_elements(double t) {
+  const double tau = 0.5 * dt_;
+  const double fb = setup_.function_value(setup_.gravity_function, t + 0.5 * tau);
+  double b[Dim];
+  for (int d = 0; d < Dim; ++d) b[d] = fb * setup_.gravity[d];
+  const double cd = t < setup_.damping_until ? setup_.damping : 0.0;
+  const Index ne = disc_.elements.size();
+  const Index* row = op_en_.row_start.data();
+  const Index* src = op_en_.source.data();
+  const auto* w = op_en_.weight.data();
+  const double* nphi = node_phi_.data();
+  const int stride = state_stride_;
+#pragma omp parallel for schedule(static)
+  for (Index e = 0; e < ne; ++e) {
+    double bar[NV] = {};
+    double grad[Dim][NV] = {};
+    for (Index k = row[e]; k < row[e + 1]; ++k) {
+      const double* p = nphi + static_cast<std::size_t>(src[k]) * NV;
+      const auto& wk = w[k];
+      for (int c = 0; c < NV; ++c) {
+        bar[c] += wk[0] * p[c];
+        for (int d = 0; d < Dim; ++d) grad[d][c] += wk[static_cast<std::size_t>(d) + 1] * p[c];
+      }
+    }
+    const auto eu = static_cast<std::size_t>(e);
+    const auto m = static_cast<std::size_t>(disc_.elements.material[eu]);
+    double dv[Dim], dsig[NS];
+    flux_rates<Dim>(grad, 1.0 / disc_.elements.density[eu], lambda_[m], shear_[m], dv, dsig);
+    double* out = &elem_phi_[eu * NV];
+    for (int i = 0; i < Dim; ++i) out[i] = bar[i] + tau * dv[i] + velocity_source(bar[i], b[i], cd, tau);
+    for (int s = 0; s < NS; ++s) out[Dim + s] = bar[Dim + s] + tau * dsig[s];
+    if (any_source_) {
+      for (int s = 0; s < NS; ++s) {
+        src_sigma_start_[eu * NS + static_cast<std::size_t>(s)] = bar[Dim + s];
+        src_rate_[eu * NS + static_cast<std::size_t>(s)] = dsig[s];
+      }
+    }
+    if (stride > 0) {
+      // History variables are interpolated from the nodes (METHOD.md §3.3: nodes are primary).
+      double* ks = &elem_state_[eu * static_cast<std::size_t>(stride)];
+      for (int j = 0; j < stride; ++j) ks[j] = 0.0;
+      for (Index k = row[e]; k < row[e + 1]; ++k) {
+        const double* kn = &node_state_[static_cast<std::size_t>(src[k]) * static_cast<std::size_t>(stride)];
+        for (int j = 0; j < stride; ++j) ks[j] += w[k][0] * kn[j];
+      }
+    }
+  }
+  if (any_source_) integrate_sources(tau, true);
+}
+
+// Step 2 (METHOD.md §5.1): elements -> nodes, t^n -> t^{n+1}.
+template <int Dim>
+void StaggeredSolver<Dim>::step_nodes(double t) {
+  const double fb = setup_.function_value(setup_.gravity_function, t + 0.5 * dt_);
+  double b[Dim];
+  for (int d = 0; d < Dim; ++d) b[d] = fb * setup_.gravity[d];
+  const double cd = t < setup_.damping_until ? setup_.damping : 0.0;
+  const double t_half = t + 0.5 * dt_;
+  const Index nn = disc_.nodes.size();
+  const Index* row = op_ne_.row_start.data();
+  const Index* src = op_ne_.source.data();
+  const auto* w = op_ne_.weight.data();
+  const double* ephi = elem_phi_.data();
+#pragma omp parallel for schedule(static)
+  for (Index i = 0; i < nn; ++i) {
+    double grad[Dim][NV] = {};
+    for (Index k = row[i]; k < row[i + 1]; ++k) {
+      const double* p = ephi + static_cast<std::size_t>(src[k]) * NV;
+      const auto& wk = w[k];
+      for (int c = 0; c < NV; ++c) {
+        for (int d = 0; d < Dim; ++d) grad[d][c] += wk[static_cast<std::size_t>(d) + 1] * p[c];
+      }
+    }
+    const auto iu = static_cast<std::size_t>(i);
+    const Index drow = diff_row_of_node_[iu];
+    if (drow >= 0) {
+      // METHOD.md §0.3 fix (a): a prescribed component enters its own gradient through the
+      // difference form with fhat = the prescribed value at t^{n+1/2}.
+      const auto dr = static_cast<std::size_t>(drow);
+      for (Index q = constraint_row_[iu]; q < constraint_row_[iu + 1]; ++q) {
+        const NodalConstraint& con = constraints_[static_cast<std::size_t>(q)];
+        const double fhat = con.value * setup_.function_value(con.function, t_half);
+        double g[Dim] = {};
+        for (Index k = diff_ne_.row_start[dr]; k < diff_ne_.row_start[dr + 1]; ++k) {
+          const double f = ephi[static_cast<std::size_t>(diff_ne_.source[static_cast<std::size_t>(k)]) * NV +
+                                static_cast<std::size_t>(con.component)];
+          for (int d = 0; d < Dim; ++d) g[d] += diff_ne_.weight[static_cast<std::size_t>(k)][d] * f;
+        }
+        for (int d = 0; d < Dim; ++d) grad[d][con.component] = g[d] - diff_ne_.weight_sum[dr][d] * fhat;
+      }
+    }
+    const auto m = static_cast<std::size_t>(disc_.nodes.material[iu]);
+    double dv[Dim], dsig[NS];
+    flux_rates<Dim>(grad, 1.0 / disc_.nodes.density[iu], lambda_[m], shear_[m], dv, dsig);
+    double* phi = &node_phi_[iu * NV];
+    for (int d = 0; d < Dim; ++d) {
+      v_prev_[iu * Dim + static_cast<std::size_t>(d)] = phi[d];
+      phi[d] += dt_ * dv[d] + velocity_source(phi[d], b[d], cd, dt_);
+    }
+    if (any_source_) {
+      for (int s = 0; s < NS; ++s) {
+        src_sigma_start_[iu * NS + static_cast<std::size_t>(s)] = phi[Dim + s];
+        src_rate_[iu * NS + static_cast<std::size_t>(s)] = dsig[s];
+      }
+    }
+    for (int s = 0; s < NS; ++s) phi[Dim + s] += dt_ * dsig[s];
+  }
+  if (any_source_) integrate_sources(dt_, false);
+}
+
+// Velocity-only fourth-order filter v <- v - eps (I - P_NE P_EN)^2 v (METHOD.md §0.3 item 3):
+// removes the nodal checkerboard that the elements cannot see; exact on linear fields.
+template <int Dim>
+void StaggeredSolver<Dim>::filter_velocity() {
+  const Index ne = disc_.elements.size();
+  const Index nn = disc_.nodes.size();
+  const double eps = setup_.filter_strength;
+  auto to_elements = [&](const double* node_field, std::size_t node_stride) {
+#pragma omp parallel for schedule(static)
+    for (Index e = 0; e < ne; ++e) {
+      double acc[Dim] = {};
+      for (Index k = op_en_.row_start[static_cast<std::size_t>(e)]; k < op_en_.row_start[static_cast<std::size_t>(e) + 1]; ++k) {
+        const double wk = op_en_.weight[static_cast<std::size_t>(k)][0];
+        const double* p = node_field + static_cast<std::size_t>(op_en_.source[static_cast<std::size_t>(k)]) * node_stride;
+        for (int d = 0; d < Dim; ++d) acc[d] += wk * p[d];
+      }
+      for (int d = 0; d < Dim; ++d) filter_elem_[static_cast<std::size_t>(e) * Dim + static_cast<std::size_t>(d)] = acc[d];
+    }
+  };
+  auto back_to_nodes = [&](Index i, double* acc) {
+    for (int d = 0; d < Dim; ++d) acc[d] = 0.0;
+    for (Index k = op_ne_.row_start[static_cast<std::size_t>(i)]; k < op_ne_.row_start[static_cast<std::size_t>(i) + 1]; ++k) {
+      const double wk = op_ne_.weight[static_cast<std::size_t>(k)][0];
+      const double* p = &filter_elem_[static_cast<std::size_t>(op_ne_.source[static_cast<std::size_t>(k)]) * Dim];
+      for (int d = 0; d < Dim; ++d) acc[d] += wk * p[d];
+    }
+  };
+  to_elements(node_phi_.data(), NV);
+#pragma omp parallel for schedule(static)
+  for (Index i = 0; i < nn; ++i) {
+    double acc[Dim];
+    back_to_nodes(i, acc);
+    for (int d = 0; d < Dim; ++d) {
+      filter_node_[static_cast<std::size_t>(i) * Dim + static_cast<std::size_t>(d)] =
+          node_phi_[static_cast<std::size_t>(i) * NV + static_cast<std::size_t>(d)] - acc[d];
+    }
+  }
+  to_elements(filter_node_.data(), Dim);
+#pragma omp parallel for schedule(static)
+  for (Index i = 0; i < nn; ++i) {
+    double acc[Dim];
+    back_to_nodes(i, acc);
+    for (int d = 0; d < Dim; ++d) {
+      const std::size_t k = static_cast<std::size_t>(i) * Dim + static_cast<std::size_t>(d);
+      node_phi_[static_cast<std::size_t>(i) * NV + static_cast<std::size_t>(d)] -= eps * (filter_node_[k] - acc[d]);
+    }
+  }
+}
+
+template <int Dim>
+double StaggeredSolver<Dim>::boundary_power() const {
+  // Power of the surface tractions: sum over face nodes of A (sigma . n) . v.
+  double power = 0.0;
+  for (Index i : boundary_nodes_) {
+    const auto iu = static_cast<std::size_t>(i);
+    const double* phi = &node_phi_[iu * NV];
+    const std::uint8_t faces = disc_.boundary.faces[iu];
+    for (int d = 0; d < Dim; ++d) {
+      for (int side = 0; side < 2; ++side) {
+        if (((faces >> (2 * d + side)) & 1u) == 0) continue;
+        const double normal = side == 0 ? -1.0 : 1.0;
+        const double area = disc_.boundary.area[iu][static_cast<std::size_t>(2 * d + side)];
+        for (int k = 0; k < Dim; ++k) power += area * phi[Dim + slot<Dim>(k, d)] * normal * phi[k];
+      }
+    }
+  }
+  return power;
+}
+
+template <int Dim>
+void StaggeredSolver<Dim>::finish_step(const double* v_prev) {
+  const Index nn = disc_.nodes.size();
+  const Index blocks = (nn + kReductionBlock - 1) / kReductionBlock;
+  constexpr int kSums = Dim + 2;  // momentum (Dim), sum m v^2, non-finite flag
+#pragma omp parallel for schedule(static)
+  for (Index blk = 0; blk < blocks; ++blk) {
+    double sums[kSums] = {};
+    const Index end = std::min(nn, (blk + 1) * kReductionBlock);
+    for (Index i = blk * kReductionBlock; i < end; ++i) {
+      const auto iu = static_cast<std::size_t>(i);
+      const double m = disc_.nodes.volume[iu] * disc_.nodes.density[iu];
+      for (int d = 0; d < Dim; ++d) {
+        const double v = node_phi_[iu * NV + static_cast<std::size_t>(d)];
+        node_u_[iu * Dim + static_cast<std::size_t>(d)] += 0.5 * dt_ * (v_prev[iu * Dim + static_cast<std::size_t>(d)] + v);
+        sums[d] += m * v;
+        sums[Dim] += m * v * v;
+        if (!std::isfinite(v)) sums[Dim + 1] = 1.0;
+      }
+    }
+    for (int s = 0; s < kSums; ++s) block_sums_[static_cast<std::size_t>(blk) * kSums + static_cast<std::size_t>(s)] = sums[s];
+  }
+  double total[kSums] = {};
+  for (Index blk = 0; blk < blocks; ++blk) {
+    for (int s = 0; s < kSums; ++s) total[s] += block_sums_[static_cast<std::size_t>(blk) * kSums + static_cast<std::size_t>(s)];
+  }
+  if (total[Dim + 1] != 0.0) {
+    Index bad = 0;
+    for (Index i = 0; i < nn; ++i) {
+      bool finite = true;
+      for (int c = 0; c < NV; ++c) finite = finite && std::isfinite(node_phi_[static_cast<std::size_t>(i) * NV + static_cast<std::size_t>(c)]);
+      if (!finite) {
+        bad = i;
+        break;
+      }
+    }
+    const auto& x = disc_.nodes.position[static_cast<std::size_t>(bad)];
+    throw SolverError(fmt::format(
+        "the solution became non-finite at step {} (t = {:.6g} s), first at node {} (x = [{}]); "
+        "the run is unstable: reduce the time step (time.cfl = {:.3g}) or check the loads and "
+        "material parameters",
+        steps_ + 1, time_ + dt_, bad, fmt::join(x.data(), x.data() + Dim, ", "), cfl_));
+  }
+  const double t_new = time_ + dt_;
+  const double fb = setup_.function_value(setup_.gravity_function, t_new);
+  double power = boundary_power();
+  for (int d = 0; d < Dim; ++d) power += fb * setup_.gravity[d] * total[d];
+  const double cd = t_new < setup_.damping_until ? setup_.damping : 0.0;
+  const double damping_power = cd * total[Dim];
+  external_work_ += 0.5 * dt_ * (last_power_ + power);
+  damping_loss_ += 0.5 * dt_ * (last_damping_power_ + damping_power);
+  last_power_ = power;
+  last_damping_power_ = damping_power;
+}
+
+template <int Dim>
+void StaggeredSolver<Dim>::step() {
+  const double t = time_;
+  step_elements(t);
+  step_nodes(t);
+  apply_constraints(t + dt_);
+  if (setup_.filter) {
+    filter_velocity();
+    apply_constraints(t + dt_);
+  }
+  finish_step(v_prev_.data());
+  time_ = t + dt_;
+  ++steps_;
+}
+
+template <int Dim>
+EnergyBalance StaggeredSolver<Dim>::energy() const {
+  EnergyBalance e;
+  const auto nn = static_cast<std::size_t>(disc_.nodes.size());
+  for (std::size_t i = 0; i < nn; ++i) {
+    const double* phi = &node_phi_[i * NV];
+    const double m = disc_.nodes.mass(static_cast<Index>(i));
+    for (int d = 0; d < Dim; ++d) e.kinetic += 0.5 * m * phi[d] * phi[d];
+    const Sym6 s = to_sym6<Dim>(phi + Dim);
+    const Sym6 eps = materials_[static_cast<std::size_t>(disc_.nodes.material[i])]->elastic().apply_inverse(s);
+    double w = 0.0;
+    for (std::size_t c = 0; c < 3; ++c) w += s[c] * eps[c];
+    for (std::size_t c = 3; c < 6; ++c) w += 2.0 * s[c] * eps[c];
+    e.strain += 0.5 * disc_.nodes.volume[i] * w;
+  }
+  e.external_work = external_work_;
+  e.damping_loss = damping_loss_;
+  e.initial_strain = initial_strain_;
+  return e;
+}
+
+template <int Dim>
+std::size_t StaggeredSolver<Dim>::state_bytes() const {
+  const std::size_t doubles = node_phi_.size() + elem_phi_.size() + node_u_.size() +
+                              node_state_.size() + elem_state_.size() + v_prev_.size() +
+                              filter_elem_.size() + filter_node_.size();
+  std::size_t bytes = doubles * sizeof(double);
+  bytes += (disc_.nodes.position.size() + disc_.elements.position.size()) * sizeof(Vec<Dim>);
+  bytes += (disc_.nodes.volume.size() + disc_.elements.volume.size()) * 2 * sizeof(double);
+  bytes += (disc_.nodes.material.size() + disc_.elements.material.size()) * sizeof(int);
+  return bytes;
+}
+
+template <int Dim>
+std::size_t StaggeredSolver<Dim>::operator_bytes() const {
+  return op_en_.bytes() + op_ne_.bytes() + diff_ne_.source.size() * (sizeof(Index) + sizeof(Vec<Dim>)) +
+         constraint_row_.size() * sizeof(Index) + constraints_.size() * sizeof(NodalConstraint) +
+         diff_row_of_node_.size() * sizeof(Index);
+}
+
+template class StaggeredSolver<1>;
+template class StaggeredSolver<2>;
+
+}  // namespace rktsph
