@@ -60,12 +60,16 @@ class MixedRate {
     for (int i = 0; i < 6; ++i) {
       (path.control[static_cast<std::size_t>(i)] == Control::stress ? S_ : E_).push_back(i);
     }
+    // The stress-controlled block D_SS is constant: invert it once (at most 6 x 6).
     const int ns = static_cast<int>(S_.size());
-    Eigen::MatrixXd Dss(ns, ns);
-    for (int a = 0; a < ns; ++a) {
-      for (int b = 0; b < ns; ++b) Dss(a, b) = D_(S_[a], S_[b]);
+    Dss_inv_.setZero();
+    if (ns > 0) {
+      Eigen::MatrixXd Dss(ns, ns);
+      for (int a = 0; a < ns; ++a) {
+        for (int b = 0; b < ns; ++b) Dss(a, b) = D_(S_[a], S_[b]);
+      }
+      Dss_inv_.topLeftCorner(ns, ns) = Dss.inverse();
     }
-    lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(Dss);
   }
 
   /// sigma_dot, eps_dot, kappa_dot; with_source = false gives the purely elastic rates.
@@ -79,17 +83,18 @@ class MixedRate {
     }
     for (int i : E_) deps[static_cast<std::size_t>(i)] = path_.rate[static_cast<std::size_t>(i)];
     // Stress-controlled components: D_SS eps_S = sigma_dot_S - D_SE eps_E - src_S.
-    if (!S_.empty()) {
-      const int ns = static_cast<int>(S_.size());
-      Eigen::VectorXd rhs(ns);
-      for (int a = 0; a < ns; ++a) {
-        const auto ia = static_cast<std::size_t>(S_[a]);
-        double r = path_.rate[ia] - src[ia];
-        for (int j : E_) r -= D_(S_[a], j) * deps[static_cast<std::size_t>(j)];
-        rhs(a) = r;
-      }
-      const Eigen::VectorXd x = lu_.solve(rhs);
-      for (int a = 0; a < ns; ++a) deps[static_cast<std::size_t>(S_[a])] = x(a);
+    const int ns = static_cast<int>(S_.size());
+    double rhs[6];
+    for (int a = 0; a < ns; ++a) {
+      const auto ia = static_cast<std::size_t>(S_[a]);
+      double r = path_.rate[ia] - src[ia];
+      for (int j : E_) r -= D_(S_[a], j) * deps[static_cast<std::size_t>(j)];
+      rhs[a] = r;
+    }
+    for (int a = 0; a < ns; ++a) {
+      double x = 0.0;
+      for (int b = 0; b < ns; ++b) x += Dss_inv_(a, b) * rhs[b];
+      deps[static_cast<std::size_t>(S_[a])] = x;
     }
     for (int i = 0; i < 6; ++i) {
       double r = src[static_cast<std::size_t>(i)];
@@ -103,7 +108,7 @@ class MixedRate {
   const LoadPath& path_;
   Mat6 D_;
   std::vector<int> S_, E_;
-  Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
+  Mat6 Dss_inv_;
 };
 
 bool finite(const Sym6& a) {

@@ -1,0 +1,404 @@
+// Perzyna models against closed forms, through the material-point path integrator
+// (materials/material_point_path.hpp) and the RK4 batch source integrator.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "material_test_util.hpp"
+#include "materials/material_point_path.hpp"
+#include "materials/source_integrator.hpp"
+#include "materials/tensor.hpp"
+
+namespace rktsph {
+namespace {
+
+using test::material_from_toml;
+
+// E = 1e7, nu = 0.3: G = 1e7/2.6.
+constexpr double kG = 1.0e7 / 2.6;
+constexpr double kY = 1.0e5;
+
+double q_of(const Sym6& s) { return invariants(s).q; }
+
+TEST(VonMisesPerzyna, NoFlowInsideTheSurface) {
+  auto m = material_from_toml(test::von_mises(1.0));
+  // Simple shear to gamma = 0.01: tau = G gamma = 38.5 kPa, q = 66.6 kPa < Y.
+  LoadPath path = LoadPath::simple_shear(1.0);
+  path.duration = 0.01;
+  path.dt = 1e-3;
+  const PathResult r = integrate_path(*m, {}, path);
+  const PathPoint& end = r.points.back();
+  EXPECT_NEAR(end.stress[3], kG * 0.01, 1e-9 * kG * 0.01);
+  EXPECT_EQ(end.state[0], 0.0);
+  EXPECT_EQ(m->relaxation_rate(end.stress, end.state.data()), 0.0);
+  Sym6 ds;
+  double dk[1];
+  m->source_rate(end.stress, end.state.data(), ds, dk);
+  for (double v : ds) EXPECT_EQ(v, 0.0);
+}
+
+TEST(VonMisesPerzyna, CohesionGivesPlaneStrainShearStrength) {
+  // CASES.md §1.2 C2: sigma_Y = sqrt(3) c, so pure shear yields at tau = c.
+  auto m = material_from_toml(
+      "model = 'perzyna_von_mises'\nE = 1e7\nnu = 0.3\ndensity = 2000\ncohesion = 5e4\n"
+      "fluidity = 1.0\n");
+  const double k[1] = {0.0};
+  EXPECT_EQ(m->relaxation_rate({0, 0, 0, 5e4 * (1 - 1e-9), 0, 0}, k), 0.0);
+  EXPECT_GT(m->relaxation_rate({0, 0, 0, 5e4 * (1 + 1e-6), 0, 0}, k), 0.0);
+}
+
+// Constant deviatoric strain rate: at steady state all the deviatoric rate is viscoplastic,
+// so gamma Phi = eps_eq_dot with eps_eq_dot = sqrt(2/3 e_dot:e_dot). For simple shear at the
+// engineering rate g (eps_xy_dot = g/2) this is g/sqrt(3). Hence
+//   power:       q = Y (1 + (eps_eq_dot/gamma)^(1/N)),
+//   exponential: q = Y (1 + ln(1 + eps_eq_dot/gamma)/N).
+TEST(VonMisesPerzyna, SteadyStateUnderConstantDeviatoricStrainRate) {
+  const double g = 1.0, gamma = 1.0;
+  const double rate_eq = g / std::sqrt(3.0);
+  struct Variant {
+    const char* keys;
+    double q_expected;
+  };
+  const Variant variants[] = {
+      {"exponent = 1.0\n", kY * (1.0 + rate_eq / gamma)},
+      {"exponent = 2.0\n", kY * (1.0 + std::sqrt(rate_eq / gamma))},
+      {"exponent = 2.0\noverstress = 'exponential'\n",
+       kY * (1.0 + std::log1p(rate_eq / gamma) / 2.0)},
+  };
+  for (const Variant& v : variants) {
+    auto m = material_from_toml(test::von_mises(gamma, v.keys));
+    LoadPath path = LoadPath::simple_shear(g);
+    path.duration = 0.3;
+    path.dt = 1e-3;
+    const PathResult r = integrate_path(*m, {}, path);
+    const PathPoint& a = r.points[r.points.size() - 2];
+    const PathPoint& b = r.points.back();
+    EXPECT_NEAR(q_of(b.stress), v.q_expected, 1e-6 * v.q_expected) << v.keys;
+    // Accumulated viscoplastic strain grows at eps_eq_dot.
+    EXPECT_NEAR((b.state[0] - a.state[0]) / (b.t - a.t), rate_eq, 1e-6) << v.keys;
+    // The stress stays pure shear.
+    EXPECT_NEAR(b.stress[0], 0.0, 1e-6);
+  }
+}
+
+// Fixed strain, N = 1, H = 0: q_dot = -3 G gamma (q - Y)/Y, so the overstress decays as
+// exp(-3 G gamma t / Y), the rate quoted in METHOD.md §4.3.
+TEST(VonMisesPerzyna, StressRelaxationDecaysAtTheMethodRate) {
+  auto m = material_from_toml(test::von_mises(1.0));
+  const double gamma = 1.0, rate = 3.0 * kG * gamma / kY;  // 115.4 1/s
+  const double q0 = 1.5 * kY;
+  const Sym6 s0{0, 0, 0, q0 / std::sqrt(3.0), 0, 0};
+  const double k0[1] = {0.0};
+  EXPECT_NEAR(m->relaxation_rate(s0, k0), rate, 1e-9 * rate);
+  LoadPath path;  // every strain rate zero
+  path.duration = 0.02;
+  path.dt = 1e-4;
+  const PathResult r = integrate_path(*m, s0, path);
+  for (const PathPoint& p : r.points) {
+    const double exact = (q0 - kY) * std::exp(-rate * p.t);
+    EXPECT_NEAR(q_of(p.stress) - kY, exact, 1e-7 * (q0 - kY)) << "t = " << p.t;
+  }
+  const PathPoint& a = r.points[50];
+  const PathPoint& b = r.points[150];
+  const double measured =
+      std::log((q_of(a.stress) - kY) / (q_of(b.stress) - kY)) / (b.t - a.t);
+  EXPECT_NEAR(measured, rate, 1e-5 * rate);
+  // The relaxed stress went into eps_vp_eq: q0 - q = 3 G eps_vp_eq.
+  EXPECT_NEAR(r.points.back().state[0], (q0 - q_of(r.points.back().stress)) / (3.0 * kG), 1e-12);
+}
+
+// Independent rate-independent reference: incremental radial return (backward Euler) for von
+// Mises with linear hardening, many small increments along the same strain path.
+Sym6 radial_return_reference(const Sym6& sigma0, const Sym6& eps_rate, double duration,
+                             double E, double nu, double Y0, double H, int increments) {
+  const double G = E / (2 * (1 + nu)), K = E / (3 * (1 - 2 * nu));
+  const double dt = duration / increments;
+  Sym6 s = sigma0;
+  double ebar = 0.0;
+  for (int n = 0; n < increments; ++n) {
+    const Sym6 de = tensor::scaled(eps_rate, dt);
+    const double dv = tensor::trace(de);
+    Sym6 tr = s;
+    for (std::size_t i = 0; i < 6; ++i) tr[i] += 2 * G * de[i];
+    for (std::size_t i = 0; i < 3; ++i) tr[i] += (K - 2 * G / 3) * dv;
+    const double p = -tensor::trace(tr) / 3;
+    const Sym6 dev = tensor::deviator(tr);
+    const double q = std::sqrt(1.5 * tensor::ddot(dev, dev));
+    const double Y = Y0 + H * ebar;
+    if (q > Y) {
+      const double dl = (q - Y) / (3 * G + H);
+      const double f = 1 - 3 * G * dl / q;
+      for (std::size_t i = 0; i < 6; ++i) tr[i] = f * dev[i] - (i < 3 ? p : 0.0);
+      ebar += dl;
+    }
+    s = tr;
+  }
+  return s;
+}
+
+TEST(VonMisesPerzyna, FastLimitApproachesRateIndependentReturnMapping) {
+  // Non-proportional: an anisotropic initial stress, then a mixed normal + shear strain rate.
+  const Sym6 s0{-50e3, -100e3, -50e3, 0, 0, 0};
+  const Sym6 rate{0.004, -0.01, 0.0, 0.003, 0.0, 0.0};
+  const double duration = 2.0, H = 1.0e6;
+  const Sym6 ref = radial_return_reference(s0, rate, duration, 1e7, 0.3, kY, H, 40000);
+  double err[2];
+  const double gammas[2] = {50.0, 500.0};
+  for (int i = 0; i < 2; ++i) {
+    auto m = material_from_toml(test::von_mises(gammas[i], "hardening_modulus = 1.0e6\n"));
+    LoadPath path;
+    path.rate = rate;
+    path.duration = duration;
+    path.dt = 1e-3;
+    const PathResult r = integrate_path(*m, s0, path);
+    double e = 0.0;
+    for (std::size_t c = 0; c < 6; ++c) e = std::max(e, std::abs(r.points.back().stress[c] - ref[c]));
+    err[i] = e / kY;
+  }
+  // The Perzyna stress approaches the rate-independent one as O(1/gamma).
+  EXPECT_LT(err[1], 2e-4);
+  EXPECT_GT(err[0] / err[1], 7.0);
+  EXPECT_LT(err[0] / err[1], 13.0);
+  // Sanity: the reference did yield well beyond Y0.
+  EXPECT_GT(q_of(ref), 1.05 * kY);
+}
+
+// One particle advanced by the batch integrator (the solver's entry point).
+Sym6 advance(const Material& m, const Sym6& s0, const Sym6& flux, double tau,
+             SourceCoupling coupling, std::vector<double>& k, SourceStats* stats = nullptr) {
+  Sym6 out{};
+  std::vector<double> kend(k.size());
+  SourceBatch b;
+  b.count = 1;
+  b.stress_components = 6;
+  b.sigma_start = s0.data();
+  b.flux_rate = flux.data();
+  b.sigma_end = out.data();
+  b.state_start = k.data();
+  b.state_end = kend.data();
+  b.coupling = coupling;
+  const SourceStats st = m.advance_source(tau, b);
+  if (stats != nullptr) *stats = st;
+  k = kend;
+  return out;
+}
+
+TEST(PerzynaSource, SubSteppingKeepsStiffSourceBoundedAndAccurate) {
+  auto m = material_from_toml(test::von_mises(1.0e4));
+  const Sym6 s0{0, 0, 0, 2.0 * kY / std::sqrt(3.0), 0, 0};  // q = 2 Y
+  const Sym6 zero{};
+  const double tau = 0.01;
+  const double lam = 3.0 * kG * 1.0e4 / kY;  // 1.15e6 1/s: lam tau = 1.15e4 >> 2.78
+  std::vector<double> k{0.0};
+  SourceStats stats;
+  const Sym6 coarse = advance(*m, s0, zero, tau, SourceCoupling::additive, k, &stats);
+  EXPECT_GE(stats.max_substeps, static_cast<long>(lam * tau / 1.0) - 1);
+  // Exact: q - Y = Y exp(-lam t), i.e. Y to round-off after tau.
+  EXPECT_NEAR(q_of(coarse), kY, 1e-9 * kY);
+  // Fine run: 100 calls of tau/100.
+  std::vector<double> kf{0.0};
+  Sym6 s = s0;
+  for (int i = 0; i < 100; ++i) s = advance(*m, s, zero, tau / 100, SourceCoupling::additive, kf);
+  for (std::size_t c = 0; c < 6; ++c) EXPECT_NEAR(coarse[c], s[c], 1e-9 * kY);
+  EXPECT_NEAR(k[0], kf[0], 1e-12);
+  // Without sub-stepping one RK4 step of this size explodes: the guard above is what matters.
+  const auto* pm = m.get();
+  SourceBatch b;
+  Sym6 out{};
+  double k0[1] = {0.0}, k1[1];
+  b.count = 1;
+  b.sigma_start = s0.data();
+  b.sigma_end = out.data();
+  b.state_start = k0;
+  b.state_end = k1;
+  detail::integrate_source_batch(
+      tau, b, 1,
+      [pm](const Sym6& a, const double* kk, Sym6& ds, double* dk) { pm->source_rate(a, kk, ds, dk); },
+      [](const Sym6&, const double*) { return 0.0; });
+  EXPECT_GT(std::abs(q_of(out) - kY), 1e3 * kY);
+}
+
+TEST(PerzynaSource, FrozenFluxAndAdditiveAgreeToSecondOrder) {
+  auto m = material_from_toml(test::von_mises(10.0));
+  const Sym6 s0{-20e3, 10e3, 0, 1.2 * kY / std::sqrt(3.0), 0, 0};
+  const Sym6 flux = m->elastic().apply({0.005, 0.0, 0.0, 0.01, 0.0, 0.0});
+  double diff[3];
+  const double taus[3] = {1e-4, 5e-5, 2.5e-5};
+  for (int i = 0; i < 3; ++i) {
+    std::vector<double> ka{0.0}, kf{0.0};
+    const Sym6 a = advance(*m, s0, flux, taus[i], SourceCoupling::additive, ka);
+    const Sym6 f = advance(*m, s0, flux, taus[i], SourceCoupling::frozen_flux, kf);
+    double d = 0.0;
+    for (std::size_t c = 0; c < 6; ++c) d = std::max(d, std::abs(a[c] - f[c]));
+    diff[i] = d;
+  }
+  EXPECT_GT(diff[0], 0.0);
+  EXPECT_NEAR(diff[0] / diff[1], 4.0, 0.4);
+  EXPECT_NEAR(diff[1] / diff[2], 4.0, 0.4);
+}
+
+// ---------------------------------------------------------------------------------------
+// Modified Cam-Clay
+
+// CASES.md Case 3 closed form: plane-strain compression from isotropic p0 with constant
+// lateral stress; s = sigma_1 - sigma_3 (compression positive).
+struct Case3Closed {
+  double nu = 0.3, E = 2.0e7, p0 = 50e3, pc = 400e3;
+  double s_yield(double M) const {
+    const double A = (1 - nu + nu * nu) / (M * M), B = (1 + nu) / 3;
+    const double a = A + B * B, b = B * (2 * p0 - pc), c = p0 * (p0 - pc);
+    return (-b + std::sqrt(b * b - 4 * a * c)) / (2 * a);
+  }
+};
+
+struct YieldPoint {
+  double s, q, p, eps_a;
+};
+
+YieldPoint first_yield(const PathResult& r, double M) {
+  // Independent of the model code: F = p' + q^2/(M^2 p') crosses p_c (state index 2).
+  auto excess = [&](const PathPoint& pt) {
+    const Invariants inv = invariants(pt.stress);
+    return inv.p + inv.q * inv.q / (M * M * inv.p) - pt.state[2];
+  };
+  for (std::size_t i = 1; i < r.points.size(); ++i) {
+    const double f0 = excess(r.points[i - 1]), f1 = excess(r.points[i]);
+    if (f0 <= 0.0 && f1 > 0.0) {
+      const double w = -f0 / (f1 - f0);
+      auto lerp = [&](double a, double b) { return a + w * (b - a); };
+      const PathPoint &a = r.points[i - 1], &b = r.points[i];
+      const double s = lerp(a.stress[0] - a.stress[1], b.stress[0] - b.stress[1]);
+      const Invariants ia = invariants(a.stress), ib = invariants(b.stress);
+      return {s, lerp(ia.q, ib.q), lerp(ia.p, ib.p), -lerp(a.strain[1], b.strain[1])};
+    }
+  }
+  return {0, 0, 0, 0};
+}
+
+TEST(CamClayPerzyna, Case3ElasticPathAndFirstYield) {
+  const Case3Closed cf;
+  auto m = material_from_toml(test::kCamClayCase3);
+  LoadPath path = LoadPath::plane_strain_compression(-0.05);  // CASES.md: 0.05 1/s
+  path.duration = 0.8;                                        // 4 % axial strain
+  path.dt = 2e-4;
+  const Sym6 s0{-cf.p0, -cf.p0, -cf.p0, 0, 0, 0};
+  const PathResult r = integrate_path(*m, s0, path);
+  // Elastic path at 1 % axial strain (t = 0.2 s).
+  const PathPoint& e = r.points[1000];
+  ASSERT_NEAR(e.t, 0.2, 1e-12);
+  const double s = cf.E * 0.01 / (1 - cf.nu * cf.nu);
+  const Invariants inv = invariants(e.stress);
+  EXPECT_NEAR(e.stress[0] - e.stress[1], s, 1e-9 * s);
+  EXPECT_NEAR(-e.stress[2], cf.p0 + cf.nu * s, 1e-9 * s);
+  EXPECT_NEAR(inv.p, cf.p0 + (1 + cf.nu) * s / 3, 1e-9 * s);
+  EXPECT_NEAR(inv.q, s * std::sqrt(1 - cf.nu + cf.nu * cf.nu), 1e-9 * s);
+  EXPECT_EQ(e.state[0], 0.0);
+  // First yield: the closed-form root and the CASES.md numbers.
+  const YieldPoint y = first_yield(r, 1.2);
+  EXPECT_NEAR(y.s, cf.s_yield(1.2), 1e-6 * y.s);
+  EXPECT_NEAR(y.s, 265.9e3, 0.1e3);
+  EXPECT_NEAR(y.q, 236.3e3, 0.1e3);
+  EXPECT_NEAR(y.p, 165.2e3, 0.1e3);
+  EXPECT_NEAR(y.eps_a, 0.0121, 0.00005);
+  // Dry side: the peak is within +0/+4 % of q_y at 0.05 1/s, then softening. At a material
+  // point the peak is flat (q within 0.5 % of q_y from 1.21 % to about 1.6 % strain), so the
+  // viscous delay moves the strain at the peak to about 1.34 %.
+  double qpk = 0.0, eps_pk = 0.0;
+  for (const PathPoint& p : r.points) {
+    if (q_of(p.stress) > qpk) {
+      qpk = q_of(p.stress);
+      eps_pk = -p.strain[1];
+    }
+  }
+  EXPECT_GE(qpk, y.q);
+  EXPECT_LE(qpk, 1.04 * y.q);
+  EXPECT_GE(eps_pk, y.eps_a);
+  EXPECT_LE(eps_pk, 1.2 * y.eps_a);
+  EXPECT_LT(q_of(r.points.back().stress), 0.99 * qpk);
+  EXPECT_LT(r.points.back().state[2], cf.pc);  // dilation shrank p_c
+}
+
+TEST(CamClayPerzyna, Case3FirstYieldWithLodeDependentM) {
+  const Case3Closed cf;
+  auto m = material_from_toml(test::kCamClayCase3 + "lode_dependent_M = true\n");
+  LoadPath path = LoadPath::plane_strain_compression(-0.05);
+  path.duration = 0.3;
+  path.dt = 2e-4;
+  const PathResult r = integrate_path(*m, {-cf.p0, -cf.p0, -cf.p0, 0, 0, 0}, path);
+  // M(theta) on this path, from sin 3 theta of the elastic stress (constant along it).
+  const double M = 1.117;
+  const YieldPoint y = first_yield(r, M);
+  EXPECT_NEAR(y.s, 245.3e3, 0.3e3);
+  EXPECT_NEAR(y.q, 218.0e3, 0.3e3);
+  EXPECT_NEAR(y.p, 156.3e3, 0.3e3);
+  EXPECT_NEAR(y.eps_a, 0.0112, 0.00005);
+}
+
+TEST(CamClayPerzyna, InitialStateFromOcrUsesEquivalentSize) {
+  auto m = material_from_toml(
+      "model = 'perzyna_cam_clay'\nE = 2e7\nnu = 0.3\ndensity = 2000\nM = 1.2\nlambda = 0.2\n"
+      "kappa = 0.02\ne0 = 1.0\nocr = 8\nfluidity = 10\n");
+  double k[3];
+  m->initial_state({-50e3, -50e3, -50e3, 0, 0, 0}, k);
+  EXPECT_DOUBLE_EQ(k[2], 400e3);
+  // Anisotropic: p' = 60 kPa, q = 30 kPa -> P_y = 60 + 900/(1.44*60) kPa.
+  m->initial_state({-50e3, -80e3, -50e3, 0, 0, 0}, k);
+  EXPECT_NEAR(k[2], 8.0 * (60e3 + 30e3 * 30e3 / (1.44 * 60e3)), 1e-6);
+  ASSERT_EQ(m->state_size(), 3);
+  const auto names = m->state_names();
+  EXPECT_EQ(std::vector<std::string>(names.begin(), names.end()),
+            (std::vector<std::string>{"eps_vp_eq", "eps_vp_vol", "p_c"}));
+}
+
+// Normally consolidated sample (p_c0 = p0): both triaxial paths end on the critical state
+// line. At the end the flow is purely deviatoric, so p' = p_c/2 and, with the overstress x,
+// q/p' = M sqrt(1 + 2x): x ~ eps_eq_dot/(gamma M) ~ 1e-3 here.
+const std::string kCamClayNC =
+    "model = 'perzyna_cam_clay'\nE = 2.0e7\nnu = 0.3\ndensity = 2000.0\nM = 1.2\n"
+    "lambda = 0.2\nkappa = 0.02\ne0 = 1.0\np_c0 = 1.0e5\nfluidity = 10.0\n";
+
+TEST(CamClayPerzyna, DrainedTriaxialNormallyConsolidatedEndsOnCriticalState) {
+  auto m = material_from_toml(kCamClayNC);
+  LoadPath path = LoadPath::drained_triaxial(-0.01);
+  path.duration = 80.0;  // 80 % axial strain (small-strain model): the approach is exponential
+  path.dt = 0.05;        // in strain with a scale of about 12 %
+  path.relaxation_target = 2.0;  // stable for RK4 (2.78); the stiff mode only tracks the surface
+  const Sym6 s0{-1e5, -1e5, -1e5, 0, 0, 0};
+  const PathResult r = integrate_path(*m, s0, path);
+  const PathPoint& end = r.points.back();
+  const Invariants inv = invariants(end.stress);
+  // Lateral stress held; drained total stress path q = 3 (p' - p0).
+  EXPECT_NEAR(end.stress[0], -1e5, 1e-6);
+  EXPECT_NEAR(end.stress[2], -1e5, 1e-6);
+  EXPECT_NEAR(inv.q, 3.0 * (inv.p - 1e5), 1e-6 * inv.q);
+  // Critical state: q = M p' = 200 kPa at p' = p0/(1 - M/3) = 166.7 kPa.
+  EXPECT_NEAR(inv.q / inv.p, 1.2, 0.002 * 1.2);
+  EXPECT_NEAR(inv.p, 1e5 / 0.6, 0.002 * 1e5 / 0.6);
+  EXPECT_NEAR(end.state[2], 2.0 * inv.p, 0.002 * 2.0 * inv.p);
+  EXPECT_LT(end.state[1], 0.0);  // compaction
+}
+
+TEST(CamClayPerzyna, UndrainedTriaxialEndsOnCriticalStateIsochorically) {
+  auto m = material_from_toml(kCamClayNC);
+  LoadPath path = LoadPath::undrained_triaxial(-0.01);
+  path.duration = 20.0;
+  path.dt = 0.01;
+  const PathResult r = integrate_path(*m, {-1e5, -1e5, -1e5, 0, 0, 0}, path);
+  for (const PathPoint& p : r.points) {
+    ASSERT_NEAR(tensor::trace(p.strain), 0.0, 1e-14) << "t = " << p.t;
+  }
+  const PathPoint& end = r.points.back();
+  const Invariants inv = invariants(end.stress);
+  EXPECT_NEAR(inv.q / inv.p, 1.2, 0.005 * 1.2);
+  EXPECT_NEAR(end.state[2], 2.0 * inv.p, 0.01 * 2.0 * inv.p);
+  // Isochoric: the elastic volume change cancels the viscoplastic one, so p' dropped by
+  // K eps_vp_vol (eps_vp_vol < 0, compaction).
+  const double K = 2.0e7 / (3 * (1 - 0.6));
+  EXPECT_LT(inv.p, 1e5);
+  EXPECT_NEAR(inv.p, 1e5 + K * end.state[1], 1e-6 * 1e5);
+}
+
+}  // namespace
+}  // namespace rktsph

@@ -1,0 +1,168 @@
+// Unit tests of the Perzyna parts: yield surfaces (value, gradient, flow vector against
+// central finite differences), overstress functions and hardening laws.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <functional>
+#include <numbers>
+
+#include "materials/hardening.hpp"
+#include "materials/overstress.hpp"
+#include "materials/tensor.hpp"
+#include "materials/yield_cam_clay.hpp"
+#include "materials/yield_von_mises.hpp"
+
+namespace rktsph {
+namespace {
+
+// Derivative of a scalar function of a symmetric tensor in TENSOR components: the Sym6 shear
+// entry stands for both sigma_ij and sigma_ji, so d/dSym6[i] is twice the tensor derivative.
+Sym6 fd_gradient(const std::function<double(const Sym6&)>& f, const Sym6& s, double h) {
+  Sym6 g;
+  for (std::size_t i = 0; i < 6; ++i) {
+    Sym6 a = s, b = s;
+    a[i] += h;
+    b[i] -= h;
+    g[i] = (f(a) - f(b)) / (2.0 * h) * (i < 3 ? 1.0 : 0.5);
+  }
+  return g;
+}
+
+const Sym6 kGeneral{-120e3, -80e3, -95e3, 15e3, -7e3, 4e3};  // Pa, all components non-zero
+
+TEST(PerzynaParts, VonMisesValueAndGradientMatchFiniteDifferences) {
+  const VonMisesSurface vm;
+  // Uniaxial compression of 3 kPa: q = 3 kPa regardless of the pressure.
+  EXPECT_NEAR(vm.value({-3e3, 0, 0, 0, 0, 0}, 1.0), 3e3, 1e-9);
+  const Sym6 g = vm.gradient(kGeneral, 1.0);
+  const Sym6 fd = fd_gradient([&](const Sym6& s) { return vm.value(s, 1.0); }, kGeneral, 1.0);
+  for (std::size_t i = 0; i < 6; ++i) EXPECT_NEAR(g[i], fd[i], 1e-7) << "component " << i;
+  // Flow: deviatoric, unit equivalent norm sqrt(2/3 m:m) = 1 (METHOD.md §1.7).
+  const Sym6 m = vm.flow(kGeneral, 1.0);
+  EXPECT_NEAR(tensor::trace(m), 0.0, 1e-14);
+  EXPECT_NEAR(tensor::equivalent_strain(m), 1.0, 1e-12);
+}
+
+TEST(PerzynaParts, CamClayValueGradientAndFlowMatchFiniteDifferences) {
+  for (bool lode : {false, true}) {
+    const CamClaySurface cc{1.2, lode};
+    const double pc = 200e3;
+    const Sym6 g = cc.gradient(kGeneral, pc);
+    const Sym6 fd = fd_gradient([&](const Sym6& s) { return cc.value(s, pc); }, kGeneral, 1.0);
+    for (std::size_t i = 0; i < 6; ++i) {
+      EXPECT_NEAR(g[i], fd[i], 1e-6 * (1.0 + std::abs(fd[i]))) << "lode " << lode << " i " << i;
+    }
+    // m = (df/dsigma)/p_c with the ellipse f = q^2 + M(theta)^2 p'(p' - p_c) (METHOD.md §1.8).
+    auto f = [&](const Sym6& s) {
+      const Invariants inv = invariants(s);
+      const Sym6 d = tensor::deviator(s);
+      const double M = cc.slope(d, 0.5 * tensor::ddot(d, d), pc).M;
+      return (inv.q * inv.q + M * M * inv.p * (inv.p - pc)) / pc;
+    };
+    const Sym6 m = cc.flow(kGeneral, pc);
+    const Sym6 fdm = fd_gradient(f, kGeneral, 1.0);
+    for (std::size_t i = 0; i < 6; ++i) {
+      EXPECT_NEAR(m[i], fdm[i], 1e-6 * (1.0 + std::abs(fdm[i]))) << "lode " << lode << " i " << i;
+    }
+  }
+}
+
+TEST(PerzynaParts, CamClayFlowDirection) {
+  const CamClaySurface cc{1.2, false};
+  const double pc = 100e3;
+  // Isotropic at p' = p_c: m = -(M^2/3) 1, i.e. compaction (tr m = -M^2 < 0).
+  const Sym6 iso = cc.flow({-pc, -pc, -pc, 0, 0, 0}, pc);
+  EXPECT_NEAR(iso[0], -1.44 / 3.0, 1e-12);
+  EXPECT_NEAR(iso[3], 0.0, 1e-15);
+  // Critical state (p' = p_c/2, q = M p'): purely deviatoric flow.
+  const double p = 0.5 * pc, q = 1.2 * p;  // triaxial compression along y
+  const Sym6 cs{-(p - q / 3.0), -(p + 2.0 * q / 3.0), -(p - q / 3.0), 0, 0, 0};
+  EXPECT_NEAR(cc.value(cs, pc), pc, 1e-9);
+  EXPECT_NEAR(tensor::trace(cc.flow(cs, pc)), 0.0, 1e-12);
+  // Dry side (p' < p_c/2) dilates, wet side compacts.
+  const Sym6 dry{-20e3, -20e3 - 60e3, -20e3, 0, 0, 0};  // p' = 40 kPa < p_c/2
+  const Sym6 wet{-80e3, -80e3 - 60e3, -80e3, 0, 0, 0};  // p' = 100 kPa > p_c/2
+  EXPECT_GT(tensor::trace(cc.flow(dry, pc)), 0.0);
+  EXPECT_LT(tensor::trace(cc.flow(wet, pc)), 0.0);
+  // Tension guard: F = p' for p' <= 0, no division by p'.
+  EXPECT_DOUBLE_EQ(cc.value({10e3, 10e3, 10e3, 5e3, 0, 0}, pc), -10e3);
+}
+
+TEST(PerzynaParts, CamClayLodeDependentM) {
+  const double Mc = 1.2;
+  const CamClaySurface cc{Mc, true};
+  const double sphi = 3.0 * Mc / (6.0 + Mc);
+  auto M_of = [&](const Sym6& s) {
+    const Sym6 d = tensor::deviator(s);
+    return cc.slope(d, 0.5 * tensor::ddot(d, d), 1e5).M;
+  };
+  // Triaxial compression along y (theta = +30 deg in the tension-positive convention): M = M_c.
+  EXPECT_NEAR(M_of({-50e3, -150e3, -50e3, 0, 0, 0}), Mc, 1e-12);
+  // Triaxial extension: M = 6 sin(phi)/(3 + sin(phi)).
+  EXPECT_NEAR(M_of({-150e3, -50e3, -150e3, 0, 0, 0}), 6.0 * sphi / (3.0 + sphi), 1e-12);
+  // CASES.md Case 3: plane-strain elastic path, nu = 0.3, has sin 3theta = 0.629, M = 1.117.
+  const double s = 100e3, nu = 0.3, p0 = 50e3;
+  EXPECT_NEAR(M_of({-p0, -(p0 + s), -(p0 + nu * s), 0, 0, 0}), 1.117, 5e-4);
+  EXPECT_NEAR(CamClaySurface::M_from_friction_angle(30.0), 1.2, 1e-12);
+}
+
+TEST(PerzynaParts, OverstressFunctions) {
+  Overstress pw{OverstressKind::power, 2.0, 0.0};
+  EXPECT_DOUBLE_EQ(pw.value(-0.1), 0.0);  // Macaulay bracket
+  EXPECT_DOUBLE_EQ(pw.value(0.0), 0.0);
+  EXPECT_NEAR(pw.value(0.3), 0.09, 1e-15);
+  EXPECT_NEAR(pw.slope(0.3), 0.6, 1e-15);
+  Overstress ex{OverstressKind::exponential, 2.0, 0.0};
+  EXPECT_NEAR(ex.value(0.3), std::exp(0.6) - 1.0, 1e-15);
+  EXPECT_NEAR(ex.slope(0.3), 2.0 * std::exp(0.6), 1e-14);
+  EXPECT_DOUBLE_EQ(ex.value(-0.3), 0.0);
+  // No dead band by default: any positive overstress flows.
+  EXPECT_GT(Overstress{}.value(1e-6), 0.0);
+  // A requested dead band suppresses flow below it and does not shift Phi above it.
+  Overstress db{OverstressKind::power, 1.0, 0.01};
+  EXPECT_DOUBLE_EQ(db.value(0.005), 0.0);
+  EXPECT_DOUBLE_EQ(db.value(0.02), 0.02);
+  // Slopes against central differences.
+  for (const Overstress& o : {pw, ex, Overstress{OverstressKind::power, 0.5, 0.0}}) {
+    const double x = 0.4, h = 1e-6;
+    EXPECT_NEAR(o.slope(x), (o.value(x + h) - o.value(x - h)) / (2 * h), 1e-6);
+  }
+}
+
+TEST(PerzynaParts, LinearHardeningWithResidualFloor) {
+  const LinearHardening h{100e3, -1e6, 10e3};
+  double k[1] = {0.05};
+  EXPECT_DOUBLE_EQ(h.size(k), 50e3);
+  k[0] = 0.2;  // 100e3 - 200e3 < floor
+  EXPECT_DOUBLE_EQ(h.size(k), 10e3);
+  EXPECT_DOUBLE_EQ(h.size_rate_per_flow({0, 0, 0, 1.0, 0, 0}, k), 0.0);  // on the floor
+  // Rate: accumulated strain sqrt(2/3 e:e); pure tensor shear e_xy = a gives 2a/sqrt(3).
+  double dk[1];
+  h.rate({0, 0, 0, 3e-3, 0, 0}, k, dk);
+  EXPECT_NEAR(dk[0], 2.0 * 3e-3 / std::sqrt(3.0), 1e-15);
+  // Volumetric strain rate does not count.
+  h.rate({1e-3, 1e-3, 1e-3, 0, 0, 0}, k, dk);
+  EXPECT_NEAR(dk[0], 0.0, 1e-18);
+}
+
+TEST(PerzynaParts, CamClayHardeningLaw) {
+  // (1 + e0)/(lambda - kappa) = 2/0.18.
+  CamClayHardening h{2.0 / 0.18, 300e3, 0.0};
+  double k[3];
+  h.initial_state(123.0, k);
+  EXPECT_DOUBLE_EQ(k[2], 300e3);
+  double dk[3];
+  const Sym6 compaction{-1e-3, -1e-3, -1e-3, 0, 0, 0};  // tr = -3e-3 (compression)
+  h.rate(compaction, k, dk);
+  EXPECT_NEAR(dk[1], -3e-3, 1e-18);
+  EXPECT_NEAR(dk[2], 300e3 * 2.0 / 0.18 * 3e-3, 1e-6);  // compaction hardens
+  h.rate(tensor::scaled(compaction, -1.0), k, dk);
+  EXPECT_LT(dk[2], 0.0);  // dilation softens
+  // OCR: p_c = OCR * (p' + q^2/(M^2 p')) of the initial stress.
+  CamClayHardening o{1.0, 0.0, 4.0};
+  o.initial_state(50e3, k);
+  EXPECT_DOUBLE_EQ(k[2], 200e3);
+}
+
+}  // namespace
+}  // namespace rktsph
