@@ -1,4 +1,6 @@
 // rktsph: Runge–Kutta Taylor SPH for the dynamics of dry and saturated soils.
+#include <omp.h>
+
 #include <iostream>
 #include <string>
 #include <vector>
@@ -11,6 +13,7 @@
 #include "core/error.hpp"
 #include "materials/material.hpp"
 #include "rktsph/version.hpp"
+#include "validation/validation.hpp"
 
 int main(int argc, char** argv) {
   using namespace rktsph;
@@ -46,6 +49,19 @@ int main(int argc, char** argv) {
 
   auto* mat_cmd = app.add_subcommand("materials", "List the constitutive models");
 
+  validation::Options val;
+  val.cases_dir = std::string(RKTSPH_SOURCE_DIR) + "/cases/thesis";
+  bool val_quick = false;
+  auto* val_cmd = app.add_subcommand(
+      "validate", "Run the thesis cases against their references; write validation/report.md");
+  val_cmd->add_option("cases", val.only, "Case numbers to run, e.g. 01 (default: all)");
+  auto* full_flag = val_cmd->add_flag("--full", val.full, "CASES.md acceptance resolutions");
+  val_cmd->add_flag("--quick", val_quick, "Coarse resolutions that fit in CI (default)")->excludes(full_flag);
+  val_cmd->add_option("--out,-o", val.out_dir, "Report folder (default: validation)");
+  val_cmd->add_option("--cases-dir", val.cases_dir, "Folder of the thesis case files");
+  val_cmd->add_flag("!--no-plots", val.plots, "Skip the matplotlib plots");
+  val_cmd->add_option("--threads,-j", run.threads, "Number of threads")->check(CLI::NonNegativeNumber);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -55,6 +71,10 @@ int main(int argc, char** argv) {
   try {
     if (run_cmd->parsed()) return run_case(run);
     if (mp_cmd->parsed()) return run_material_point(mp_file, mp_out, mp_overrides);
+    if (val_cmd->parsed()) {
+      if (run.threads > 0) omp_set_num_threads(run.threads);
+      return validation::run_validation(val);
+    }
     if (mat_cmd->parsed()) {
       for (const auto& [name, description] : registered_materials()) {
         std::cout << fmt::format("{:<22} {}\n", name, description);

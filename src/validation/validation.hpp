@@ -1,0 +1,80 @@
+#pragma once
+// `rktsph validate`: run the thesis cases, compare them with their references (CASES.md) by
+// code in this repository, write a report with plots, and fail if a criterion is not met.
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace rktsph::validation {
+
+struct Metric {
+  std::string name;
+  double value = 0.0;
+  std::string relation;  // "<=" or ">=" ; empty for a reported figure with no tolerance
+  double tolerance = 0.0;
+  std::string unit;
+  /// Non-empty when the criterion is known not to be met and the reason is understood: the
+  /// report still shows it as not met (with the reason), but it does not fail the command.
+  std::string known_deviation;
+  bool pass() const {
+    if (relation == "<=") return value <= tolerance;
+    if (relation == ">=") return value >= tolerance;
+    return true;
+  }
+};
+
+inline Metric metric(std::string name, double value, std::string relation, double tolerance,
+                     std::string unit) {
+  Metric m;
+  m.name = std::move(name);
+  m.value = value;
+  m.relation = std::move(relation);
+  m.tolerance = tolerance;
+  m.unit = std::move(unit);
+  return m;
+}
+
+struct CaseReport {
+  std::string id;     // "01"
+  std::string title;
+  std::string reference;
+  std::vector<Metric> metrics;
+  std::vector<std::string> plots;  // PNG files relative to the report
+  std::vector<std::string> notes;
+  double seconds = 0.0;
+  /// Every criterion met.
+  bool passed() const {
+    for (const auto& m : metrics) {
+      if (!m.pass()) return false;
+    }
+    return true;
+  }
+  /// Every criterion met, except those with a documented known deviation.
+  bool acceptable() const {
+    for (const auto& m : metrics) {
+      if (!m.pass() && m.known_deviation.empty()) return false;
+    }
+    return true;
+  }
+};
+
+struct Options {
+  bool full = false;             // CASES.md resolutions (else coarse, CI-sized)
+  std::string out_dir = "validation";
+  std::string cases_dir;         // where cases/thesis lives
+  std::vector<std::string> only;  // case ids; empty = all
+  bool plots = true;
+};
+
+/// Run one validation case; writes CSV data and plots under out_dir/case<id>/.
+using CaseRunner = std::function<CaseReport(const Options&, const std::string& case_dir)>;
+
+CaseReport validate_case01(const Options& options, const std::string& case_dir);
+
+/// Run the selected cases and write out_dir/report.md. Returns 0 if all pass, 1 otherwise.
+int run_validation(const Options& options);
+
+/// Run /usr/bin/python3 on a plotting script; returns false (with a note) if unavailable.
+bool run_plot_script(const std::string& script, const std::string& data_dir, std::string& note);
+
+}  // namespace rktsph::validation
