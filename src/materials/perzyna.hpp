@@ -57,7 +57,8 @@ class PerzynaMaterial final : public Material {
   /// Linearised relaxation rate of the normalised overstress x = (F - Y)/Y along the flow
   /// (METHOD.md §4.3): gamma Phi'(x) [dF/dsigma : D^e : m + (1 + x)|dY/d(gamma Phi)|] / Y.
   /// von Mises, N = 1, H = 0 gives 3 G gamma / Y; Cam-Clay gives gamma K M^2/p_c on the
-  /// isotropic axis and 6 G gamma/p_c at the critical state. Zero inside the surface.
+  /// isotropic axis (plus the hardening term gamma M^2 (1+e0)/(lambda-kappa)) and about
+  /// 6 G gamma/p_c at the critical state. Zero inside the surface.
   double relaxation_rate(const Sym6& sigma, const double* state) const override {
     const double Y = hardening_.size(state);
     const double x = (surface_.value(sigma, Y) - Y) / Y;

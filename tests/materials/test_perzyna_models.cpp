@@ -402,3 +402,55 @@ TEST(CamClayPerzyna, UndrainedTriaxialEndsOnCriticalStateIsochorically) {
 
 }  // namespace
 }  // namespace rktsph
+
+namespace rktsph {
+namespace {
+
+// The Cam-Clay relaxation estimate is the actual decay rate on the isotropic axis: with
+// x = p'/p_c - 1 at fixed strain, x_dot = -gamma M^2 (K + p_c (1+e0)/(lambda-kappa)) x / p_c.
+TEST(CamClayPerzyna, RelaxationRateMatchesIsotropicDecay) {
+  auto m = test::material_from_toml(test::kCamClayCase3);
+  const double pc = 4.0e5, K = 2.0e7 / (3 * (1 - 0.6)), M2 = 1.44, h = 2.0 / 0.18, gamma = 10.0;
+  const double expected = gamma * M2 * (K + pc * h) / pc;
+  const double p0 = pc * (1 + 1e-4);
+  const Sym6 s0{-p0, -p0, -p0, 0, 0, 0};
+  const double k0[3] = {0, 0, pc};
+  EXPECT_NEAR(m->relaxation_rate(s0, k0), expected, 1e-3 * expected);
+  LoadPath path;  // fixed strain
+  path.duration = 2.0 / expected;
+  path.dt = path.duration / 200;
+  const PathResult r = integrate_path(*m, s0, path);
+  auto x = [](const PathPoint& p) { return invariants(p.stress).p / p.state[2] - 1.0; };
+  const double measured = std::log(x(r.points.front()) / x(r.points.back())) / path.duration;
+  EXPECT_NEAR(measured, expected, 1e-3 * expected);
+}
+
+// The batch integrator honours a state stride (several materials sharing one state array).
+TEST(PerzynaSource, BatchHonoursStateStride) {
+  auto m = test::material_from_toml(test::von_mises(10.0));
+  const double tau1 = 2.0 * 1.0e5 / std::sqrt(3.0);
+  const double sig[2][6] = {{0, 0, 0, 0.4 * tau1, 0, 0}, {0, 0, 0, tau1, 0, 0}};
+  double out[2][6] = {};
+  double k0[8] = {0, -1, -1, -1, 0, -1, -1, -1};
+  double k1[8] = {-1, -1, -1, -1, -1, -1, -1, -1};
+  SourceBatch b;
+  b.count = 2;
+  b.stress_components = 6;
+  b.sigma_start = &sig[0][0];
+  b.sigma_start_stride = 6;
+  b.sigma_end = &out[0][0];
+  b.sigma_end_stride = 6;
+  b.state_start = k0;
+  b.state_end = k1;
+  b.state_stride = 4;
+  m->advance_source(1e-3, b);
+  EXPECT_EQ(k1[0], 0.0);   // particle 0 is inside the surface: no flow
+  EXPECT_GT(k1[4], 0.0);   // particle 1 flowed
+  EXPECT_EQ(k1[1], -1.0);  // slots between particles untouched
+  EXPECT_EQ(k1[5], -1.0);
+  EXPECT_DOUBLE_EQ(out[0][3], 0.4 * tau1);
+  EXPECT_LT(out[1][3], tau1);
+}
+
+}  // namespace
+}  // namespace rktsph
