@@ -1,0 +1,86 @@
+// Energy balance of the V1 solver: kinetic + strain - external work (+ damping loss) stays
+// near zero on the 1D bar under a smooth load (METHOD.md §0.3 item 2: 0.7 % at N = 100) and
+// on an undamped 2D block under a gravity ramp.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "../support/test_util.hpp"
+#include "solvers/staggered_solver.hpp"
+
+namespace rktsph {
+namespace {
+
+TEST(Energy, BarUnderSmoothLoadBalancesWithinOnePercent) {
+  const test::ThreadCount threads(1);
+  const std::string file = std::string(RKTSPH_SOURCE_DIR) + "/cases/thesis/01_elastic_bar_1d.toml";
+  auto setup = read_case<1>(load_case_document(
+      file, {"functions.load.type=smoothstep", "functions.load.duration=0.0353553"}));
+  const double L = 10.0, E = 1.0e7, sigma0 = 1.0e4;
+  StaggeredSolver<1> solver(setup);
+  ASSERT_EQ(solver.particles().nodes.size(), 101);
+  const double c = std::sqrt(E / 2000.0);
+  const double scale = sigma0 * 2.0 * sigma0 * L / E;  // 200 J: twice the work of sigma0 over L
+  double worst = 0.0, max_work = 0.0;
+  while (solver.time() < 3.5 * L / c) {
+    solver.step();
+    const EnergyBalance e = solver.energy();
+    worst = std::max(worst, std::abs(e.imbalance()));
+    max_work = std::max(max_work, e.external_work);
+  }
+  std::printf("1D bar, smooth load, N = 100, to 3.5 L/c: max |imbalance| = %.4g J = %.3g %% of %.0f J "
+              "(external work up to %.4g J)\n",
+              worst, 100.0 * worst / scale, scale, max_work);
+  EXPECT_GT(max_work, 0.25 * scale) << "the load did no work: the test would be vacuous";
+  EXPECT_LT(worst, 0.01 * scale);
+}
+
+TEST(Energy, UndampedBlockUnderGravityRampConservesEnergy) {
+  const test::ThreadCount threads(1);
+  test::TempDir dir;
+  auto setup = test::case_from_string<2>(dir, R"(
+[geometry]
+dimension = 2
+spacing = 0.25
+[[geometry.block]]
+min = [0.0, 0.0]
+max = [4.0, 4.0]
+[material]
+model = "elastic"
+E = 1.0e7
+nu = 0.3
+density = 2000.0
+[functions.ramp]
+type = "smoothstep"
+duration = 0.2
+[body_force]
+gravity = [0.0, -9.81]
+function = "ramp"
+[[boundary]]
+name = "base"
+y = [0.0, 0.0]
+velocity = { x = 0.0, y = 0.0 }
+[time]
+end = 1.0
+cfl = 0.9
+)");
+  StaggeredSolver<2> solver(setup);
+  double worst = 0.0, max_work = 0.0;
+  while (solver.time() < 0.5) {
+    solver.step();
+    if (solver.step_count() % 5 == 0) {
+      const EnergyBalance e = solver.energy();
+      worst = std::max(worst, std::abs(e.imbalance()));
+      max_work = std::max(max_work, std::abs(e.external_work));
+    }
+  }
+  std::printf("2D block, gravity ramp, undamped, to 0.5 s: max |imbalance| = %.4g J = %.3g %% of "
+              "the max external work %.4g J\n",
+              worst, 100.0 * worst / max_work, max_work);
+  EXPECT_GT(max_work, 0.0);
+  EXPECT_LT(worst, 0.03 * max_work);
+}
+
+}  // namespace
+}  // namespace rktsph
