@@ -203,6 +203,16 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     const io::Section g = root.table("geometry");
     g.integer("dimension");
     c.dx = g.positive("spacing");
+    if (g.has("condition")) {
+      // CASES.md §1.1 / Case 2: a 1D bar in uniaxial strain (default) or uniaxial stress.
+      const std::string cond = g.string("condition");
+      if (Dim != 1) g.fail("condition", "only a 1D case takes a lateral condition (2D is plane strain)");
+      if (cond == "uniaxial_strain") c.condition = BarCondition::uniaxial_strain;
+      else if (cond == "uniaxial_stress") c.condition = BarCondition::uniaxial_stress;
+      else g.fail("condition", fmt::format("unknown condition '{}' (known: uniaxial_strain, uniaxial_stress)", cond));
+    } else {
+      g.string("condition", "");
+    }
     if (g.has("origin")) c.origin = read_vector<Dim>(g, "origin");
     else g.number("origin", 0.0);
     const auto blocks = g.tables("block");
@@ -322,8 +332,14 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
       if (c.gravity.norm() == 0.0) {
         is->fail("type", "a geostatic initial stress needs [body_force] gravity");
       }
+    } else if (type == "uniform") {
+      // A uniform initial stress, Pa (tension positive), e.g. an isotropic confinement.
+      c.initial_stress = InitialStressKind::uniform;
+      const std::vector<std::string> comps = Dim == 1 ? std::vector<std::string>{"xx", "yy", "zz"}
+                                                      : std::vector<std::string>{"xx", "yy", "zz", "xy"};
+      for (std::size_t i = 0; i < comps.size(); ++i) c.uniform_stress[i == 3 ? 3 : i] = is->number(comps[i], 0.0);
     } else {
-      is->fail("type", fmt::format("unknown initial stress '{}' (known: zero, geostatic)", type));
+      is->fail("type", fmt::format("unknown initial stress '{}' (known: zero, geostatic, uniform)", type));
     }
     is->finish();
   }

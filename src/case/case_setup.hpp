@@ -47,7 +47,9 @@ struct ProbeSpec {
   std::vector<std::string> fields;
 };
 
-enum class InitialStressKind { zero, geostatic };
+enum class InitialStressKind { zero, geostatic, uniform };
+/// 1D only: the lateral condition of the bar (CASES.md §1.1, Case 2).
+enum class BarCondition { uniaxial_strain, uniaxial_stress };
 enum class Scheme { staggered, collocated };
 
 template <int Dim>
@@ -63,6 +65,9 @@ struct CaseSetup {
   double dx = 0.0;
   Vec<Dim> origin = Vec<Dim>::Zero();
   std::vector<Block<Dim>> blocks;
+  /// 1D: uniaxial strain (lateral strains zero; modulus lambda + 2G) or uniaxial stress
+  /// (lateral stresses zero; modulus E, materials wrapped by UniaxialStressMaterial).
+  BarCondition condition = BarCondition::uniaxial_strain;
 
   // kernel
   double h_over_dx = 1.2;
@@ -78,6 +83,7 @@ struct CaseSetup {
   InitialStressKind initial_stress = InitialStressKind::zero;
   std::optional<double> k0;            // geostatic lateral coefficient; default nu/(1-nu)
   std::optional<double> surface_level;  // geostatic ground surface (vertical axis = last axis)
+  Sym6 uniform_stress{};                 // uniform initial stress (xx, yy, zz, xy, yz, xz), Pa
   Vec<Dim> initial_velocity = Vec<Dim>::Zero();
 
   // time

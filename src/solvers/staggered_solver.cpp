@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "core/error.hpp"
+#include "materials/uniaxial_stress.hpp"
 
 namespace rktsph {
 
@@ -56,12 +57,23 @@ template <int Dim>
 StaggeredSolver<Dim>::StaggeredSolver(CaseSetup<Dim>& setup)
     : setup_(setup), kernel_(setup.h_over_dx * setup.dx) {
   materials_ = std::move(setup.materials);
+  const bool uniaxial_stress = Dim == 1 && setup.condition == BarCondition::uniaxial_stress;
   std::vector<double> densities;
-  for (const auto& m : materials_) {
+  for (auto& m : materials_) {
     densities.push_back(m->density());
-    lambda_.push_back(m->elastic().lambda);
-    shear_.push_back(m->elastic().G);
-    c_max_ = std::max(c_max_, m->elastic().p_wave_speed());
+    if (uniaxial_stress) {
+      // CASES.md Case 2: scalar sigma with zero lateral stresses. The flux uses lambda = 0 and
+      // 2G = E (axial modulus E, lateral stress rates zero) and the wave speed sqrt(E/rho);
+      // the source sees (sxx, 0, 0) through the decorator (materials/uniaxial_stress.hpp).
+      m = std::make_unique<UniaxialStressMaterial>(std::move(m));
+      lambda_.push_back(0.0);
+      shear_.push_back(0.5 * m->elastic().E);
+      c_max_ = std::max(c_max_, std::sqrt(m->elastic().E / m->density()));
+    } else {
+      lambda_.push_back(m->elastic().lambda);
+      shear_.push_back(m->elastic().G);
+      c_max_ = std::max(c_max_, m->elastic().p_wave_speed());
+    }
     any_source_ = any_source_ || m->has_source();
   }
   disc_ = discretise<Dim>(setup.blocks, setup.dx, setup.origin, densities);
@@ -240,6 +252,8 @@ void StaggeredSolver<Dim>::set_initial_state() {
       const double k0 = setup_.k0.value_or(nu / (1.0 - nu));
       const double sv = -disc_.nodes.density[i] * g * (surface - disc_.nodes.position[i][vertical]);
       for (int n = 0; n < 3; ++n) phi[Dim + n] = (n == vertical ? 1.0 : k0) * sv;
+    } else if (setup_.initial_stress == InitialStressKind::uniform) {
+      from_sym6<Dim>(setup_.uniform_stress, phi + Dim);
     }
     if (state_stride_ > 0) {
       materials_[m]->initial_state(to_sym6<Dim>(phi + Dim),

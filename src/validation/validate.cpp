@@ -32,6 +32,8 @@ bool run_plot_script(const std::string& script, const std::string& data_dir, std
 int run_validation(const Options& opt) {
   const std::vector<std::pair<std::string, CaseRunner>> cases = {
       {"01", validate_case01},
+      {"02", validate_case02},
+      {"03", validate_case03},
   };
   fs::create_directories(opt.out_dir);
   std::vector<CaseReport> reports;
