@@ -16,6 +16,9 @@ namespace rktsph {
 
 namespace {
 
+// Largest Courant number accepted, as in StaggeredSolver (METHOD.md §0.3 item 4).
+constexpr double kMaxCourant = 1.3;
+
 std::vector<std::string> split(const std::string& s, char sep) {
   std::vector<std::string> out;
   std::string cur;
@@ -360,6 +363,21 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     } else {
       c.cfl = t.positive("cfl", 0.5);
       t.number("dt", 0.0);
+    }
+    // METHOD.md §0.3 item 4: reject C > kMaxCourant here, where the key's line is known (the
+    // solver checks again for setups built in code, without a line).
+    // Same wave speed as StaggeredSolver: the bar speed sqrt(E/rho) in 1D uniaxial stress.
+    double c_max = 0.0;
+    for (const auto& m : c.materials) {
+      const bool bar = Dim == 1 && c.condition == BarCondition::uniaxial_stress;
+      c_max = std::max(c_max, bar ? std::sqrt(m->elastic().E / m->density()) : m->elastic().p_wave_speed());
+    }
+    const double courant = has_dt ? *c.dt * c_max / c.dx : *c.cfl;
+    if (courant > kMaxCourant) {
+      t.fail(has_dt ? "dt" : "cfl",
+             fmt::format("the Courant number c dt/dx = {:.3f} exceeds {} (c = {:.4g} m/s, dx = {} "
+                         "m); the scheme is unstable beyond it (METHOD.md §0.3 item 4)",
+                         courant, kMaxCourant, c_max, c.dx));
     }
     t.finish();
   }

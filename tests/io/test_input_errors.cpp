@@ -1,0 +1,258 @@
+// Every class of bad input makes the real binary exit with status 2 and a message that names
+// the file, the line and the dotted key (docs/case-format.md); never a crash.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <string>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "../support/test_util.hpp"
+
+namespace rktsph {
+namespace {
+
+// A valid 2D case (one step); each test breaks one thing in it.
+constexpr const char* kBase = R"(title = "input error base"
+
+[geometry]
+dimension = 2
+spacing = 0.5
+
+[[geometry.block]]
+min = [0.0, 0.0]
+max = [2.0, 1.0]
+
+[material]
+model = "elastic"
+E = 1.0e7
+nu = 0.3
+density = 2000.0
+
+[[boundary]]
+name = "base"
+y = [0.0, 0.0]
+velocity = { x = 0.0, y = 0.0 }
+
+[time]
+end = 0.001
+cfl = 0.5
+
+[[probe]]
+name = "corner"
+position = [2.0, 1.0]
+fields = ["vx", "syy"]
+)";
+
+std::string replace(std::string text, const std::string& from, const std::string& to) {
+  const auto pos = text.find(from);
+  EXPECT_NE(pos, std::string::npos) << "test set-up: '" << from << "' not in the base case";
+  if (pos != std::string::npos) text.replace(pos, from.size(), to);
+  return text;
+}
+
+// 1-based line of the first line of `text` that contains `needle`.
+int line_of(const std::string& text, const std::string& needle) {
+  const auto pos = text.find(needle);
+  EXPECT_NE(pos, std::string::npos) << needle;
+  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(pos), '\n'));
+}
+
+struct Outcome {
+  int status;
+  std::string err;
+  std::string file;
+};
+
+Outcome run_case_text(const test::TempDir& dir, const std::string& text,
+                      const std::vector<std::string>& sets = {}) {
+  const std::string file = dir.write("bad_case.toml", text);
+  std::string cmd = fmt::format("\"{}\" run \"{}\" --out \"{}\" -q", RKTSPH_BINARY, file, dir.file("out"));
+  for (const auto& s : sets) cmd += fmt::format(" --set '{}'", s);
+  cmd += " 2>&1 1>/dev/null";
+  const auto r = test::run_command(cmd);
+  return {r.status, r.out, file};
+}
+
+// The common contract: status 2 (not a crash), the file and the dotted key named.
+void expect_input_error(const Outcome& o, const std::string& key,
+                        const std::vector<std::string>& also = {}) {
+  EXPECT_NE(o.status, 134) << "abort: " << o.err;
+  EXPECT_NE(o.status, 139) << "segfault: " << o.err;
+  EXPECT_EQ(o.status, 2) << o.err;
+  EXPECT_NE(o.err.find(o.file), std::string::npos) << "file not named: " << o.err;
+  if (!key.empty()) {
+    EXPECT_NE(o.err.find("'" + key + "'"), std::string::npos) << "key '" << key << "' not named: " << o.err;
+  }
+  for (const auto& s : also) EXPECT_NE(o.err.find(s), std::string::npos) << "'" << s << "' missing: " << o.err;
+  EXPECT_EQ(o.err.find("terminate"), std::string::npos) << o.err;
+}
+
+// Accept "line N," (followed by the key) or "line N:" (syntax errors, missing keys).
+bool names_line(const std::string& err, int line) {
+  return err.find(fmt::format("line {},", line)) != std::string::npos ||
+         err.find(fmt::format("line {}:", line)) != std::string::npos;
+}
+
+void expect_error_at(const Outcome& o, int line, const std::string& key,
+                     const std::vector<std::string>& also = {}) {
+  EXPECT_TRUE(names_line(o.err, line)) << "expected line " << line << ": " << o.err;
+  expect_input_error(o, key, also);
+}
+
+TEST(InputErrors, BaseCaseRuns) {
+  test::TempDir dir;
+  const auto o = run_case_text(dir, kBase);
+  EXPECT_EQ(o.status, 0) << o.err;
+}
+
+TEST(InputErrors, UnknownKeyListsAcceptedKeys) {
+  test::TempDir dir;
+  const std::string text = replace(kBase, "nu = 0.3\n", "nu = 0.3\nYoungs = 1.0e7\n");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "Youngs"), "material.Youngs",
+                  {"unknown key", "accepts", "E", "density", "nu", "model"});
+}
+
+TEST(InputErrors, UnknownKeyInAnArrayOfTables) {
+  test::TempDir dir;
+  const std::string text = replace(kBase, "max = [2.0, 1.0]\n", "max = [2.0, 1.0]\nmaterail = \"soil\"\n");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "materail"), "geometry.block[0].materail", {"unknown key", "min", "max"});
+}
+
+TEST(InputErrors, WrongType) {
+  test::TempDir dir;
+  const std::string text = replace(kBase, "nu = 0.3", "nu = \"0.3\"");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "nu = "), "material.nu", {"must be a number", "string"});
+}
+
+TEST(InputErrors, WrongTypeOfAnArray) {
+  test::TempDir dir;
+  const std::string text = replace(kBase, "min = [0.0, 0.0]", "min = 0.0");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "min = 0.0"), "geometry.block[0].min", {"array"});
+}
+
+TEST(InputErrors, MissingRequiredKey) {
+  test::TempDir dir;
+  const std::string text = replace(kBase, "density = 2000.0\n", "");
+  const auto o = run_case_text(dir, text);
+  // The error points at the table that lacks the key.
+  expect_error_at(o, line_of(text, "[material]"), "material.density", {"missing"});
+}
+
+TEST(InputErrors, NonPositiveYoungsModulus) {
+  test::TempDir dir;
+  for (const char* bad : {"E = 0.0", "E = -1.0e7"}) {
+    const std::string text = replace(kBase, "E = 1.0e7", bad);
+    const auto o = run_case_text(dir, text);
+    expect_error_at(o, line_of(text, bad), "material.E", {"> 0"});
+  }
+}
+
+TEST(InputErrors, PoissonRatioOutOfRange) {
+  test::TempDir dir;
+  for (const char* bad : {"nu = 0.5", "nu = -1.0", "nu = 0.7"}) {
+    const std::string text = replace(kBase, "nu = 0.3", bad);
+    const auto o = run_case_text(dir, text);
+    expect_error_at(o, line_of(text, bad), "material.nu", {"(-1, 0.5)"});
+  }
+}
+
+TEST(InputErrors, NonPositiveDensity) {
+  test::TempDir dir;
+  const std::string text = replace(kBase, "density = 2000.0", "density = 0");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "density = 0"), "material.density", {"> 0"});
+}
+
+TEST(InputErrors, NonPositiveSpacing) {
+  test::TempDir dir;
+  const std::string text = replace(kBase, "spacing = 0.5", "spacing = -0.5");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "spacing"), "geometry.spacing", {"> 0"});
+}
+
+TEST(InputErrors, MisalignedBlock) {
+  test::TempDir dir;
+  const std::string text = replace(kBase, "max = [2.0, 1.0]", "max = [2.2, 1.0]");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "[[geometry.block]]"), "geometry.block[0]", {"lattice"});
+}
+
+TEST(InputErrors, ProbeOutsideTheBody) {
+  test::TempDir dir;
+  const std::string text = replace(kBase, "position = [2.0, 1.0]", "position = [5.0, 1.0]");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "position = "), "probe[0].position", {"outside", "corner"});
+}
+
+TEST(InputErrors, UnknownProbeField) {
+  test::TempDir dir;
+  const std::string text = replace(kBase, "fields = [\"vx\", \"syy\"]", "fields = [\"vx\", \"velocity\"]");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "position = "), "probe.fields", {"velocity", "available", "sxy"});
+}
+
+TEST(InputErrors, CourantNumberAboveLimit) {
+  test::TempDir dir;
+  {
+    const std::string text = replace(kBase, "cfl = 0.5", "cfl = 1.35");
+    const auto o = run_case_text(dir, text);
+    expect_error_at(o, line_of(text, "cfl = "), "time.cfl", {"1.3"});
+  }
+  {
+    // Through dt: c = 82.04 m/s, dx = 0.5 m -> C = 1.64 for dt = 0.01 s.
+    const std::string text = replace(kBase, "cfl = 0.5", "dt = 0.01");
+    const auto o = run_case_text(dir, text);
+    expect_error_at(o, line_of(text, "dt = "), "time.dt", {"1.641"});
+  }
+  {
+    // Just below the limit is accepted.
+    const auto o = run_case_text(dir, replace(kBase, "cfl = 0.5", "cfl = 1.25"));
+    EXPECT_EQ(o.status, 0) << o.err;
+  }
+}
+
+TEST(InputErrors, UnknownMaterialModelListsKnownModels) {
+  test::TempDir dir;
+  const std::string text = replace(kBase, "model = \"elastic\"", "model = \"mohr_coulomb\"");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "model = "), "material.model",
+                  {"mohr_coulomb", "elastic", "perzyna_von_mises", "perzyna_cam_clay"});
+}
+
+TEST(InputErrors, InvalidTomlSyntax) {
+  test::TempDir dir;
+  const std::string text = replace(kBase, "E = 1.0e7", "E = = 1.0e7");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "E = = "), "", {"not valid TOML"});
+}
+
+TEST(InputErrors, SetOverrideWithWrongType) {
+  test::TempDir dir;
+  {
+    const auto o = run_case_text(dir, kBase, {"material.E=stiff"});
+    expect_input_error(o, "material.E", {"command line", "must be a number", "string"});
+  }
+  {
+    const auto o = run_case_text(dir, kBase, {"time.cfl=[0.5]"});
+    expect_input_error(o, "time.cfl", {"command line", "array"});
+  }
+  {
+    // A misspelt --set key is an unknown key like one in the file.
+    const auto o = run_case_text(dir, kBase, {"material.Ee=1.0e7"});
+    expect_input_error(o, "material.Ee", {"unknown key", "command line"});
+  }
+  {
+    // A good override runs.
+    const auto o = run_case_text(dir, kBase, {"material.E=2.0e7"});
+    EXPECT_EQ(o.status, 0) << o.err;
+  }
+}
+
+}  // namespace
+}  // namespace rktsph
