@@ -20,19 +20,21 @@ namespace rktsph {
 
 template <int Dim>
 struct CorrectedOperator {
-  /// Per pair: weight[0] interpolates, weight[1..Dim] differentiate along x, y, z.
-  using Weights = std::array<double, Dim + 1>;
+  /// Per pair: the interpolation weight, and the gradient weights along x, y, z. Kept in
+  /// separate arrays so that a loop needing only one of them streams only that one.
+  using GradWeights = std::array<double, Dim>;
 
   std::vector<Index> row_start;  // CSR: pairs of target a are [row_start[a], row_start[a+1])
   std::vector<Index> source;     // source particle of each pair
-  std::vector<Weights> weight;
+  std::vector<double> interp;
+  std::vector<GradWeights> grad;
   Index degenerate_rows = 0;     // rows that fell back to Shepard / uncorrected (too few sources)
 
   Index rows() const { return static_cast<Index>(row_start.size()) - 1; }
   std::size_t pairs() const { return source.size(); }
   std::size_t bytes() const {
     return row_start.size() * sizeof(Index) + source.size() * sizeof(Index) +
-           weight.size() * sizeof(Weights);
+           interp.size() * sizeof(double) + grad.size() * sizeof(GradWeights);
   }
 };
 

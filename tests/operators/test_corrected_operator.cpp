@@ -41,8 +41,8 @@ Errors<Dim> apply_errors(const CorrectedOperator<Dim>& op, const std::vector<Vec
     for (Index k = op.row_start[static_cast<std::size_t>(a)]; k < op.row_start[static_cast<std::size_t>(a) + 1]; ++k) {
       const auto ku = static_cast<std::size_t>(k);
       const double fb = f(sources.position[static_cast<std::size_t>(op.source[ku])]);
-      val += op.weight[ku][0] * fb;
-      for (int d = 0; d < Dim; ++d) g[d] += op.weight[ku][static_cast<std::size_t>(d) + 1] * fb;
+      val += op.interp[ku] * fb;
+      for (int d = 0; d < Dim; ++d) g[d] += op.grad[ku][static_cast<std::size_t>(d)] * fb;
     }
     e.interp = std::max(e.interp, std::abs(val - f(xa)) / scale);
     e.grad = std::max(e.grad, (g - grad(xa)).norm() / scale);
