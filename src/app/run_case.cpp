@@ -29,7 +29,7 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-enum class FieldKind { velocity, displacement, stress, pressure, von_mises, history };
+enum class FieldKind { velocity, displacement, stress, pressure, von_mises, history, pore_pressure, total_stress };
 struct FieldRef {
   FieldKind kind;
   int index = 0;
@@ -51,6 +51,15 @@ FieldRef parse_field(const std::string& name, const StaggeredSolver<Dim>& s, con
     }
   }
   if (name == "p") return {FieldKind::pressure, 0};
+  if (s.saturated()) {  // V3: pore pressure and total stresses (sigma' - p_w 1)
+    if (name == "pw") return {FieldKind::pore_pressure, 0};
+    for (std::size_t c = 0; c < 6; ++c) {
+      if (name == fmt::format("total_s{}", kStressComponentNames[c])) {
+        const int sl = stress_slot<Dim>(static_cast<StressComponent>(c));
+        if (sl >= 0) return {FieldKind::total_stress, sl};
+      }
+    }
+  }
   if (name == "q") return {FieldKind::von_mises, 0};
   const auto& names = s.history_names();
   for (std::size_t i = 0; i < names.size(); ++i) {
@@ -63,6 +72,7 @@ FieldRef parse_field(const std::string& name, const StaggeredSolver<Dim>& s, con
     if (stress_slot<Dim>(static_cast<StressComponent>(c)) >= 0) known.push_back(fmt::format("s{}", kStressComponentNames[c]));
   }
   known.insert(known.end(), {"p", "q"});
+  if (s.saturated()) known.insert(known.end(), {"pw", "total_sxx", "..."});
   known.insert(known.end(), names.begin(), names.end());
   throw InputError(fmt::format("{}, key 'probe.fields': unknown field '{}' for probe '{}' "
                                "(available: {})",
@@ -79,6 +89,8 @@ double node_field(const StaggeredSolver<Dim>& s, Index node, const FieldRef& f) 
     case FieldKind::displacement: return s.node_displacement()[i * Dim + static_cast<std::size_t>(f.index)];
     case FieldKind::stress: return phi[Dim + f.index];
     case FieldKind::pressure: return invariants(to_sym6<Dim>(phi + Dim)).p;
+    case FieldKind::pore_pressure: return s.node_pore_pressure()[i];
+    case FieldKind::total_stress: return phi[Dim + f.index] - (f.index < 3 ? s.node_pore_pressure()[i] : 0.0);
     case FieldKind::von_mises: return invariants(to_sym6<Dim>(phi + Dim)).q;
     case FieldKind::history: {
       const int m = s.particles().nodes.material[i];
@@ -141,6 +153,19 @@ std::vector<io::PointField> set_fields(const StaggeredSolver<Dim>& s, bool nodes
       if (slot >= 0) f.values[i] = hist[i * static_cast<std::size_t>(s.history_stride()) + static_cast<std::size_t>(slot)];
     }
     out.push_back(std::move(f));
+  }
+  if (nodes && s.saturated()) {
+    // V3: pore pressure (compression positive) and the total stresses sigma' - p_w 1; the
+    // stress fields above are effective stresses.
+    const auto& pw = s.node_pore_pressure();
+    out.push_back({"pw", 1, pw});
+    for (std::size_t c = 0; c < 6; ++c) {
+      const int sl = stress_slot<Dim>(static_cast<StressComponent>(c));
+      if (sl < 0) continue;
+      io::PointField f{fmt::format("total_s{}", kStressComponentNames[c]), 1, std::vector<double>(n)};
+      for (std::size_t i = 0; i < n; ++i) f.values[i] = phi[i * NV + static_cast<std::size_t>(Dim + sl)] - (c < 3 ? pw[i] : 0.0);
+      out.push_back(std::move(f));
+    }
   }
   io::PointField mat{"material", 1, std::vector<double>(n)};
   for (std::size_t i = 0; i < n; ++i) mat.values[i] = set.material[i];
@@ -350,6 +375,27 @@ int run_dim(const RunOptions& opt, const CaseDocument& doc) {
                   {"imbalance", e.imbalance()}}},
       {"output_frames", frame},
   };
+  // Damping switched off by the kinetic-energy test (damping.until_kinetic_ratio), or null.
+  summary["damping_off_time"] = std::isfinite(solver.damping_off_time())
+                                    ? nlohmann::json(solver.damping_off_time())
+                                    : nlohmann::json(nullptr);
+  summary["peak_kinetic_energy"] = solver.peak_kinetic_energy();
+  if (const PressureSolveStats* ps = solver.pressure_stats()) {
+    // V3: the pore-pressure solve (METHOD.md §2.4): PCG iterations, residual, time share.
+    summary["pressure_solve"] = {
+        {"preconditioner", setup.fluid.incomplete_cholesky ? "incomplete_cholesky" : "jacobi"},
+        {"tolerance", setup.fluid.tolerance},
+        {"unknowns", solver.pressure_solver()->unknowns()},
+        {"solves", ps->solves},
+        {"iterations_max", ps->max_iterations},
+        {"iterations_mean", ps->mean_iterations()},
+        {"final_residual", ps->last_error},
+        {"max_residual", ps->max_error},
+        {"solve_seconds", ps->seconds},
+        {"pressure_step_seconds", solver.pressure_step_seconds()},
+        {"share_of_loop_time", loop_seconds > 0 ? solver.pressure_step_seconds() / loop_seconds : 0.0},
+    };
+  }
   std::ofstream(out / "summary.json") << summary.dump(2) << "\n";
   if (!opt.quiet) {
     if (exit_code == 0) {

@@ -38,6 +38,34 @@ struct BoundarySpec {
   std::vector<std::pair<int, double>> velocity;  // (axis, m/s)
   std::vector<std::pair<int, double>> stress;    // (stress slot, Pa)
   int function = -1;                              // index into CaseSetup::functions, -1 = 1
+  // V3 (saturated) pore-pressure conditions, METHOD.md §4.1: a drained face (p_w prescribed,
+  // Pa, scaled by `function`) or an explicitly impermeable one (dp_w/dn = 0, the default).
+  std::optional<double> pore_pressure;
+  bool impermeable = false;
+};
+
+/// V3: the pore fluid and the pressure solver (case keys [fluid], docs/case-format.md
+/// "Saturated soil (V3)"). The material `density` is the MIXTURE density
+/// rho = n rho_f + (1 - n) rho_s.
+struct FluidSpec {
+  double porosity = 0.0;                 // n
+  double density = 1000.0;               // rho_f, kg/m^3
+  double bulk_modulus = 0.0;             // K_f, Pa
+  double grain_bulk_modulus = 0.0;       // K_s, Pa; 0 = incompressible grains
+  double conductivity = 0.0;             // k, m/s
+  double gravity = 9.81;                 // g used in k_w = k / (rho_f g), m/s^2
+  double saturation = 1.0;               // S_w
+  double tolerance = 1e-8;               // relative residual of the PCG
+  int max_iterations = 2000;
+  bool incomplete_cholesky = false;      // preconditioner: false = Jacobi (default)
+  bool deferred_correction = true;       // Schwaiger correction on the right-hand side
+  double initial_pore_pressure = 0.0;    // Pa, uniform
+  /// 1/Q* = S_w n / K_f + (1 - n)/K_s (METHOD.md §1.4), 1/Pa
+  double inverse_storage() const {
+    return saturation * porosity / bulk_modulus + (grain_bulk_modulus > 0.0 ? (1.0 - porosity) / grain_bulk_modulus : 0.0);
+  }
+  /// k_w = k / (rho_f g), m^3 s / kg
+  double permeability() const { return conductivity / (density * gravity); }
 };
 
 struct ProbeSpec {
@@ -77,6 +105,10 @@ struct CaseSetup {
   int gravity_function = -1;
   double damping = 0.0;        // 1/s, velocity damping source -c_d v (METHOD.md §4.2)
   double damping_until = 0.0;  // s: damping switched off from this time on
+  /// s: damping also switched off once the kinetic energy has fallen below this fraction of
+  /// its peak (0 = never), tested from damping_ratio_from on (e.g. the end of a gravity ramp)
+  double damping_until_kinetic_ratio = 0.0;
+  double damping_ratio_from = 0.0;
   std::vector<BoundarySpec<Dim>> boundaries;
 
   // initial state
@@ -93,6 +125,8 @@ struct CaseSetup {
 
   // solver
   Scheme scheme = Scheme::staggered;
+  bool saturated = false;  // solver.version = "v3": the v-p_w model (METHOD.md §1.4, §5.3)
+  FluidSpec fluid;
   bool filter = true;
   double filter_strength = 0.5;
   SourceCoupling coupling = SourceCoupling::additive;

@@ -7,6 +7,7 @@
 // advances nodes from element gradients over dt. Sources (body force, damping, viscoplastic
 // relaxation) are integrated by Runge–Kutta and added to the flux increment (§2.2).
 // Particles do not move: every operator is built once, and the time loop allocates nothing.
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -15,6 +16,7 @@
 #include "core/kernel.hpp"
 #include "geometry/particles.hpp"
 #include "operators/corrected_operator.hpp"
+#include "solvers/pore_pressure.hpp"
 
 namespace rktsph {
 
@@ -82,9 +84,29 @@ class StaggeredSolver {
   std::size_t pairs() const { return op_en_.pairs() + op_ne_.pairs(); }
   Index degenerate_operator_rows() const { return op_en_.degenerate_rows + op_ne_.degenerate_rows; }
   long max_source_substeps() const { return max_substeps_; }
+  /// Damping coefficient in force at time t: c_d before damping.until and before the
+  /// kinetic-energy switch (damping.until_kinetic_ratio) has fired, else 0.
+  double damping_at(double t) const {
+    return (t < setup_.damping_until && t < damping_off_time_) ? setup_.damping : 0.0;
+  }
+  /// Time at which the kinetic-energy switch turned the damping off (infinity if it has not).
+  double damping_off_time() const { return damping_off_time_; }
+  double peak_kinetic_energy() const { return kinetic_peak_; }
 
   /// Replace the nodal velocities (tests: seed a mode and watch it).
   std::vector<double>& mutable_node_phi() { return node_phi_; }
+
+  // ---- V3, saturated soil (METHOD.md §1.4, §2.4, §5.3; solvers/staggered_saturated.cpp).
+  // node_phi holds the EFFECTIVE stress sigma'; the total stress is sigma' - p_w 1.
+  bool saturated() const { return saturated_; }
+  /// Pore pressure per node, Pa, compression positive (empty in V1).
+  const std::vector<double>& node_pore_pressure() const { return pw_; }
+  std::vector<double>& mutable_node_pore_pressure() { return pw_; }
+  /// Statistics of the pressure solves (nullptr in V1) and the wall time of the whole pressure
+  /// step (divergence, solve, velocity correction), s.
+  const PressureSolveStats* pressure_stats() const { return pressure_ ? &pressure_->stats() : nullptr; }
+  double pressure_step_seconds() const { return pressure_seconds_; }
+  const PorePressureSolver* pressure_solver() const { return pressure_.get(); }
 
  private:
   void build_constraints();
@@ -96,6 +118,16 @@ class StaggeredSolver {
   void finish_step(const double* v_prev);
   double boundary_power() const;
   void integrate_sources(double tau, bool on_elements);
+  // V3 hooks (solvers/staggered_saturated.cpp)
+  void build_saturated();
+  void pressure_step(double t_new);
+  /// Value of a prescribed component at time t. V3: a prescribed normal stress is a TOTAL
+  /// stress, so the effective stress held in phi is sigma' = sigma + p_w there.
+  double constraint_value(std::size_t node, const NodalConstraint& c, double t) const {
+    double v = c.value * setup_.function_value(c.function, t);
+    if (saturated_ && c.component >= Dim && c.component < 2 * Dim) v += pw_[node];
+    return v;
+  }
 
   CaseSetup<Dim>& setup_;
   std::vector<std::unique_ptr<Material>> materials_;
@@ -135,6 +167,18 @@ class StaggeredSolver {
   // energy accounting
   double external_work_ = 0.0, damping_loss_ = 0.0, initial_strain_ = 0.0;
   double last_power_ = 0.0, last_damping_power_ = 0.0;
+  double kinetic_peak_ = 0.0, damping_off_time_ = std::numeric_limits<double>::infinity();
+
+  // ---- V3 state (empty in V1)
+  bool saturated_ = false;
+  std::vector<double> pw_, pw_old_, pw_source_;
+  std::vector<bool> pw_drained_;
+  std::vector<double> pw_value_;      // prescribed pore pressure at drained nodes, Pa
+  std::vector<int> pw_function_;      // its time function
+  CorrectedOperator<Dim> op_nn_;      // nodes -> nodes: div v*, grad p^{n+1}
+  std::unique_ptr<PorePressureSolver> pressure_;
+  double inv_storage_ = 0.0;          // 1/Q*, 1/Pa
+  double pressure_seconds_ = 0.0;
 };
 
 }  // namespace rktsph

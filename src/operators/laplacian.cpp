@@ -1,0 +1,95 @@
+#include "operators/laplacian.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Dense>
+
+#include "neighbours/cell_list.hpp"
+
+namespace rktsph {
+
+template <int Dim>
+NodeLaplacian<Dim> build_node_laplacian(const ParticleSet<Dim>& nodes,
+                                        const CubicSplineKernel<Dim>& kernel,
+                                        const std::vector<std::uint8_t>& wall_axes) {
+  using Triplet = Eigen::Triplet<double>;
+  const auto n = static_cast<std::size_t>(nodes.size());
+  const CellList<Dim> cells(nodes.position, kernel.support_radius());
+
+  struct Pair {
+    Index j;
+    Vec<Dim> x_ij;  // x_I - x_J
+    double r;
+  };
+  std::vector<std::vector<Pair>> pairs(n);
+  NodeLaplacian<Dim> out;
+  out.c.assign(n, 2.0);
+  // Per node: the vector b_I = c_I A_I^{-T} P g_I that multiplies V_J grad_I W_IJ in the
+  // gradient correction (zero where A_I is singular).
+  std::vector<Vec<Dim>> corr(n, Vec<Dim>::Zero());
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec<Dim>& xi = nodes.position[i];
+    cells.for_each_neighbour(xi, [&](Index j, const Vec<Dim>& x_ij, double r) {
+      if (static_cast<std::size_t>(j) != i && r > 0.0) pairs[i].push_back({j, x_ij, r});
+    });
+    std::sort(pairs[i].begin(), pairs[i].end(), [](const Pair& a, const Pair& b) { return a.j < b.j; });
+    Mat<Dim> A = Mat<Dim>::Zero();
+    Vec<Dim> g = Vec<Dim>::Zero();
+    for (const Pair& p : pairs[i]) {
+      const double V = nodes.volume[static_cast<std::size_t>(p.j)];
+      const Vec<Dim> gw = V * kernel.gradient(p.x_ij);
+      A -= gw * p.x_ij.transpose();  // grad_I W_IJ (x) (x_J - x_I)
+      g += gw;
+    }
+    // Singularity guard (METHOD.md §3.5): A is dimensionless, about the identity inside, about
+    // 1/2 along the normal at a wall; a small determinant relative to the trace means too few
+    // neighbours on one side (c_I = 2, no gradient correction).
+    const double det = A.determinant();
+    const double scale = std::pow(std::abs(A.trace()) / Dim, Dim);
+    if (pairs[i].size() < static_cast<std::size_t>(Dim) + 1 || !(det > 1e-3 * scale) || scale == 0.0) {
+      ++out.degenerate_rows;
+      continue;
+    }
+    const Mat<Dim> Ainv = A.inverse();
+    out.c[i] = 2.0 / Dim * Ainv.trace();
+    Vec<Dim> Pg = g;
+    if (!wall_axes.empty()) {
+      for (int d = 0; d < Dim; ++d) {
+        if ((wall_axes[i] >> d) & 1u) Pg[d] = 0.0;  // prescribed (zero) normal derivative
+      }
+    }
+    corr[i] = out.c[i] * Ainv.transpose() * Pg;
+  }
+
+  std::vector<Triplet> full, sym;
+  for (std::size_t i = 0; i < n; ++i) {
+    double diag_full = 0.0, diag_sym = 0.0;
+    const double Vi = nodes.volume[i];
+    for (const Pair& p : pairs[i]) {
+      const auto j = static_cast<std::size_t>(p.j);
+      const double Vj = nodes.volume[j];
+      const double F = kernel.derivative(p.r) / p.r;  // < 0 inside the support
+      const double lf = out.c[i] * Vj * (-F) - corr[i].dot(Vj * kernel.gradient(p.x_ij));
+      const double ls = 0.25 * (out.c[i] + out.c[j]) * (Vi + Vj) * (-F);
+      full.emplace_back(static_cast<int>(i), static_cast<int>(j), lf);
+      sym.emplace_back(static_cast<int>(i), static_cast<int>(j), ls);
+      diag_full -= lf;
+      diag_sym -= ls;
+    }
+    full.emplace_back(static_cast<int>(i), static_cast<int>(i), diag_full);
+    sym.emplace_back(static_cast<int>(i), static_cast<int>(i), diag_sym);
+  }
+  out.full.resize(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(n));
+  out.symmetric.resize(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(n));
+  out.full.setFromTriplets(full.begin(), full.end());
+  out.symmetric.setFromTriplets(sym.begin(), sym.end());
+  return out;
+}
+
+template NodeLaplacian<1> build_node_laplacian<1>(const ParticleSet<1>&, const CubicSplineKernel<1>&,
+                                                  const std::vector<std::uint8_t>&);
+template NodeLaplacian<2> build_node_laplacian<2>(const ParticleSet<2>&, const CubicSplineKernel<2>&,
+                                                  const std::vector<std::uint8_t>&);
+
+}  // namespace rktsph

@@ -1,0 +1,138 @@
+// GCC reports a false -Wnull-dereference inside Eigen's sparse headers when the iterative
+// solvers grab a matrix (the outer-index pointer of a possibly empty matrix, SparseRef.h); the
+// suppression must cover the header locations, hence before every include.
+#pragma GCC diagnostic ignored "-Wnull-dereference"
+#include "solvers/pore_pressure.hpp"
+
+#include <chrono>
+#include <cmath>
+
+#include <Eigen/IterativeLinearSolvers>
+#include <fmt/format.h>
+
+#include "core/error.hpp"
+
+namespace rktsph {
+
+struct PorePressureSolver::Impl {
+  Sparse K;        // free-free block of I/(Q dt) - k_eff S
+  Sparse S_fd;     // free rows, drained columns of S (Dirichlet values to the right-hand side)
+  Sparse D;        // free rows of L - S, all columns (deferred correction)
+  Eigen::ConjugateGradient<Sparse, Eigen::Lower | Eigen::Upper, Eigen::DiagonalPreconditioner<double>> cg_diag;
+  Eigen::ConjugateGradient<Sparse, Eigen::Lower | Eigen::Upper, Eigen::IncompleteCholesky<double>> cg_ic;
+  Eigen::VectorXd rhs, x, p_all, p_d;
+};
+
+PorePressureSolver::~PorePressureSolver() = default;
+
+const PorePressureSolver::Sparse& PorePressureSolver::matrix() const { return impl_->K; }
+
+PorePressureSolver::PorePressureSolver(const Sparse& full, const Sparse& symmetric,
+                                       const std::vector<bool>& dirichlet, const Settings& settings)
+    : impl_(std::make_unique<Impl>()), settings_(settings) {
+  const auto n = static_cast<std::size_t>(full.rows());
+  index_.assign(n, -1);
+  std::vector<Index> drained_index(n, -1);
+  Index nd = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (dirichlet[i]) {
+      drained_index[i] = nd++;
+    } else {
+      index_[i] = static_cast<Index>(free_.size());
+      free_.push_back(static_cast<Index>(i));
+    }
+  }
+  const auto nf = static_cast<Eigen::Index>(free_.size());
+  using Triplet = Eigen::Triplet<double>;
+  std::vector<Triplet> k, sfd, d;
+  for (Eigen::Index r = 0; r < nf; ++r) {
+    const auto i = static_cast<Eigen::Index>(free_[static_cast<std::size_t>(r)]);
+    k.emplace_back(r, r, settings.inv_q_dt);
+    for (Sparse::InnerIterator it(symmetric, i); it; ++it) {
+      const auto j = static_cast<std::size_t>(it.col());
+      if (dirichlet[j]) {
+        sfd.emplace_back(r, drained_index[j], it.value());
+      } else {
+        k.emplace_back(r, index_[j], -settings.k_eff * it.value());
+      }
+      d.emplace_back(r, it.col(), -it.value());
+    }
+    for (Sparse::InnerIterator it(full, i); it; ++it) d.emplace_back(r, it.col(), it.value());
+  }
+  impl_->K.resize(nf, nf);
+  impl_->K.setFromTriplets(k.begin(), k.end());
+  impl_->S_fd.resize(nf, nd);
+  impl_->S_fd.setFromTriplets(sfd.begin(), sfd.end());
+  impl_->D.resize(nf, static_cast<Eigen::Index>(n));
+  impl_->D.setFromTriplets(d.begin(), d.end());
+  impl_->D.prune(0.0, 1e-14);
+  impl_->rhs.resize(nf);
+  impl_->x.resize(nf);
+  impl_->p_all.resize(static_cast<Eigen::Index>(n));
+  impl_->p_d.resize(nd);
+  if (nf == 0) return;
+  // K and its preconditioner are factorised once (METHOD.md §2.4 "Solver").
+  if (settings.preconditioner == PressurePreconditioner::diagonal) {
+    impl_->cg_diag.setTolerance(settings.tolerance);
+    impl_->cg_diag.setMaxIterations(settings.max_iterations);
+    impl_->cg_diag.compute(impl_->K);
+    if (impl_->cg_diag.info() != Eigen::Success) throw SolverError("pore pressure: the Jacobi preconditioner failed");
+  } else {
+    impl_->cg_ic.setTolerance(settings.tolerance);
+    impl_->cg_ic.setMaxIterations(settings.max_iterations);
+    impl_->cg_ic.compute(impl_->K);
+    if (impl_->cg_ic.info() != Eigen::Success) {
+      throw SolverError("pore pressure: the incomplete-Cholesky factorisation of K failed");
+    }
+  }
+}
+
+void PorePressureSolver::solve(const std::vector<double>& source, const std::vector<double>& p_old,
+                               std::vector<double>& p) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto nf = static_cast<Eigen::Index>(free_.size());
+  if (nf == 0) return;
+  Impl& m = *impl_;
+  Eigen::Index nd = 0;
+  for (std::size_t i = 0; i < p.size(); ++i) {
+    m.p_all[static_cast<Eigen::Index>(i)] = p_old[i];
+    if (index_[i] < 0) m.p_d[nd++] = p[i];
+  }
+  for (Eigen::Index r = 0; r < nf; ++r) {
+    const auto i = static_cast<std::size_t>(free_[static_cast<std::size_t>(r)]);
+    m.rhs[r] = source[i];
+    m.x[r] = p_old[i];
+  }
+  // Drained values at t^{n+1}: -K_fd p_d = k_eff S_fd p_d.
+  if (nd > 0) m.rhs.noalias() += settings_.k_eff * (m.S_fd * m.p_d);
+  if (settings_.deferred_correction) m.rhs.noalias() += settings_.k_eff * (m.D * m.p_all);
+  int iterations = 0;
+  double error = 0.0;
+  bool ok = false;
+  if (settings_.preconditioner == PressurePreconditioner::diagonal) {
+    m.x = m.cg_diag.solveWithGuess(m.rhs, m.x);
+    iterations = static_cast<int>(m.cg_diag.iterations());
+    error = m.cg_diag.error();
+    ok = m.cg_diag.info() == Eigen::Success;
+  } else {
+    m.x = m.cg_ic.solveWithGuess(m.rhs, m.x);
+    iterations = static_cast<int>(m.cg_ic.iterations());
+    error = m.cg_ic.error();
+    ok = m.cg_ic.info() == Eigen::Success;
+  }
+  if (!ok || !std::isfinite(error)) {
+    throw SolverError(fmt::format("pore pressure: the conjugate gradient did not converge ({} iterations, "
+                                  "relative residual {:.3g}, tolerance {:.3g})",
+                                  iterations, error, settings_.tolerance));
+  }
+  for (Eigen::Index r = 0; r < nf; ++r) p[static_cast<std::size_t>(free_[static_cast<std::size_t>(r)])] = m.x[r];
+  ++stats_.solves;
+  stats_.total_iterations += iterations;
+  stats_.max_iterations = std::max<long>(stats_.max_iterations, iterations);
+  stats_.last_iterations = iterations;
+  stats_.last_error = error;
+  stats_.max_error = std::max(stats_.max_error, error);
+  stats_.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace rktsph

@@ -1,0 +1,74 @@
+#pragma once
+// The pore-pressure step of the V3 fractional-step scheme (METHOD.md §2.4 step 2, §5.3):
+//
+//   p^{n+1}/(Q* dt) - k_eff L p^{n+1} = p^n/(Q* dt) - S_w div v*,   k_eff = k_w + S_w dt / rho,
+//
+// on the nodes, with L the corrected Laplacian of operators/laplacian.hpp. The matrix
+// K = I/(Q* dt) - k_eff S uses the symmetric part S of L, so K is symmetric positive definite;
+// the rest, k_eff (L - S) p^n, is deferred to the right-hand side (METHOD.md §3.5, §6 item 8).
+// Drained nodes (p prescribed) are eliminated symmetrically: their rows and columns leave K and
+// the known values move to the right-hand side. K and its preconditioner are built once (the
+// particles do not move and dt is fixed); each step is one Eigen::ConjugateGradient solve
+// started from p^n. Nothing here is a hand-written Krylov method.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Eigen/SparseCore>
+
+#include "core/types.hpp"
+
+namespace rktsph {
+
+enum class PressurePreconditioner { diagonal, incomplete_cholesky };
+
+struct PressureSolveStats {
+  long solves = 0;
+  long total_iterations = 0;
+  long max_iterations = 0;
+  int last_iterations = 0;
+  double last_error = 0.0;  // relative residual |K x - b| / |b| of the last solve
+  double max_error = 0.0;
+  double seconds = 0.0;     // wall time in solve()
+  double mean_iterations() const { return solves > 0 ? static_cast<double>(total_iterations) / static_cast<double>(solves) : 0.0; }
+};
+
+class PorePressureSolver {
+ public:
+  using Sparse = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+  struct Settings {
+    double inv_q_dt = 0.0;   // 1/(Q* dt), 1/(Pa s)
+    double k_eff = 0.0;      // k_w + S_w dt/rho, m^3 s/kg
+    double tolerance = 1e-8;  // relative residual
+    int max_iterations = 2000;
+    PressurePreconditioner preconditioner = PressurePreconditioner::diagonal;
+    bool deferred_correction = true;  // add k_eff (L - S) p^n to the right-hand side
+  };
+
+  /// `full` and `symmetric` are L and S (1/m^2); `dirichlet[I]` is true at drained nodes.
+  PorePressureSolver(const Sparse& full, const Sparse& symmetric, const std::vector<bool>& dirichlet,
+                     const Settings& settings);
+  ~PorePressureSolver();
+  PorePressureSolver(const PorePressureSolver&) = delete;
+  PorePressureSolver& operator=(const PorePressureSolver&) = delete;
+
+  /// One step: `p` holds p^n on entry (with the drained nodes already set to their values at
+  /// t^{n+1}) and p^{n+1} on exit. `source[I]` = p^n_I/(Q* dt) - S_w (div v*)_I. Throws
+  /// SolverError if the conjugate gradient does not converge.
+  void solve(const std::vector<double>& source, const std::vector<double>& p_old, std::vector<double>& p);
+
+  const PressureSolveStats& stats() const { return stats_; }
+  Index unknowns() const { return static_cast<Index>(free_.size()); }
+  /// K restricted to the free (non-drained) nodes (tests: symmetry, definiteness).
+  const Sparse& matrix() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  std::vector<Index> free_;   // free node of each unknown
+  std::vector<Index> index_;  // unknown of each node, -1 at drained nodes
+  Settings settings_;
+  PressureSolveStats stats_;
+};
+
+}  // namespace rktsph

@@ -1,0 +1,118 @@
+// V3: the saturated v-p_w extension of the staggered RKT-SPH solver (METHOD.md §1.4, §2.4,
+// §5.3). The explicit part (elements, then v* and sigma' at the nodes) is V1's, with grad p^n
+// added to the element half-step (staggered_solver.cpp, marked "V3"); this file holds the
+// set-up of the pressure equation and the pressure step: div v*, the PCG solve of
+// K p^{n+1} = RHS (solvers/pore_pressure.hpp) and the velocity correction
+// v^{n+1} = v* - (dt/rho) grad p^{n+1}.
+#include <chrono>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "core/error.hpp"
+#include "operators/laplacian.hpp"
+#include "solvers/staggered_solver.hpp"
+
+namespace rktsph {
+
+template <int Dim>
+void StaggeredSolver<Dim>::build_saturated() {
+  saturated_ = true;
+  const FluidSpec& fl = setup_.fluid;
+  const auto nn = static_cast<std::size_t>(disc_.nodes.size());
+  pw_.assign(nn, fl.initial_pore_pressure);
+  pw_old_.assign(nn, 0.0);
+  pw_source_.assign(nn, 0.0);
+  pw_drained_.assign(nn, false);
+  pw_value_.assign(nn, 0.0);
+  pw_function_.assign(nn, -1);
+
+  // Pore-pressure conditions (METHOD.md §4.1): drained entries are Dirichlet rows, impermeable
+  // entries (and every face not drained) are walls dp/dn = 0. A later entry wins.
+  const double tol = 1e-6 * setup_.dx + 1e-12;
+  for (const auto& spec : setup_.boundaries) {
+    if (!spec.pore_pressure && !spec.impermeable) continue;
+    for (std::size_t i = 0; i < nn; ++i) {
+      if (!spec.region.contains(disc_.nodes.position[i], tol)) continue;
+      pw_drained_[i] = spec.pore_pressure.has_value();
+      pw_value_[i] = spec.pore_pressure.value_or(0.0);
+      pw_function_[i] = spec.function;
+    }
+  }
+  std::vector<std::uint8_t> wall_axes(nn, 0);
+  for (std::size_t i = 0; i < nn; ++i) {
+    if (pw_drained_[i]) {
+      pw_[i] = pw_value_[i] * setup_.function_value(pw_function_[i], 0.0);
+      continue;
+    }
+    const std::uint8_t faces = disc_.boundary.faces[i];
+    for (int d = 0; d < Dim; ++d) {
+      if ((faces >> (2 * d)) & 3u) wall_axes[i] = static_cast<std::uint8_t>(wall_axes[i] | (1u << d));
+    }
+  }
+
+  op_nn_ = build_corrected_operator<Dim>(disc_.nodes.position, disc_.nodes, kernel_);
+  const NodeLaplacian<Dim> lap = build_node_laplacian<Dim>(disc_.nodes, kernel_, wall_axes);
+
+  // K = I/(Q* dt) - k_eff S with k_eff = k_w + S_w dt/rho (METHOD.md §2.4). One mixture density
+  // is assumed for the fractional-step term (the densest material: the largest stabilisation is
+  // not needed, the smallest k_eff changes little; a single K keeps it symmetric).
+  double rho = 0.0;
+  for (const auto& m : materials_) rho = std::max(rho, m->density());
+  inv_storage_ = fl.inverse_storage();
+  PorePressureSolver::Settings s;
+  s.inv_q_dt = inv_storage_ / dt_;
+  s.k_eff = fl.permeability() + fl.saturation * dt_ / rho;
+  s.tolerance = fl.tolerance;
+  s.max_iterations = fl.max_iterations;
+  s.preconditioner = fl.incomplete_cholesky ? PressurePreconditioner::incomplete_cholesky
+                                            : PressurePreconditioner::diagonal;
+  s.deferred_correction = fl.deferred_correction;
+  pressure_ = std::make_unique<PorePressureSolver>(lap.full, lap.symmetric, pw_drained_, s);
+}
+
+template <int Dim>
+void StaggeredSolver<Dim>::pressure_step(double t_new) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const Index nn = disc_.nodes.size();
+  const double sw = setup_.fluid.saturation;
+  const double inv_q_dt = inv_storage_ / dt_;
+  pw_old_ = pw_;
+  const Index* row = op_nn_.row_start.data();
+  const Index* src = op_nn_.source.data();
+  const auto* wg = op_nn_.grad.data();
+  double* phi = node_phi_.data();
+  // RHS_I = p^n_I/(Q* dt) - S_w (div v*)_I; drained nodes take their value at t^{n+1}.
+#pragma omp parallel for schedule(static)
+  for (Index i = 0; i < nn; ++i) {
+    const auto iu = static_cast<std::size_t>(i);
+    double div = 0.0;
+    for (Index k = row[i]; k < row[i + 1]; ++k) {
+      const double* v = phi + static_cast<std::size_t>(src[k]) * NV;
+      for (int d = 0; d < Dim; ++d) div += wg[k][static_cast<std::size_t>(d)] * v[d];
+    }
+    pw_source_[iu] = pw_old_[iu] * inv_q_dt - sw * div;
+    if (pw_drained_[iu]) pw_[iu] = pw_value_[iu] * setup_.function_value(pw_function_[iu], t_new);
+  }
+  pressure_->solve(pw_source_, pw_old_, pw_);
+  // Velocity correction v^{n+1} = v* - (dt/rho) grad p^{n+1} (same-set corrected gradient).
+#pragma omp parallel for schedule(static)
+  for (Index i = 0; i < nn; ++i) {
+    const auto iu = static_cast<std::size_t>(i);
+    double g[Dim] = {};
+    for (Index k = row[i]; k < row[i + 1]; ++k) {
+      const double p = pw_[static_cast<std::size_t>(src[k])];
+      for (int d = 0; d < Dim; ++d) g[d] += wg[k][static_cast<std::size_t>(d)] * p;
+    }
+    const double f = dt_ / disc_.nodes.density[iu];
+    for (int d = 0; d < Dim; ++d) phi[iu * NV + static_cast<std::size_t>(d)] -= f * g[d];
+  }
+  pressure_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+template void StaggeredSolver<1>::build_saturated();
+template void StaggeredSolver<2>::build_saturated();
+template void StaggeredSolver<1>::pressure_step(double);
+template void StaggeredSolver<2>::pressure_step(double);
+
+}  // namespace rktsph
