@@ -60,47 +60,85 @@ struct SampleResult {
   double slope = NAN;           // fitted dq/d eps_a for 0.2 q_y <= q <= 0.8 q_y
   std::vector<Snapshot> snaps;
   double band_angle = NAN, band_offset = NAN;  // degrees; distance of the band axis from the imperfection, m
+  double band_angle_whole = NAN, band_angle_upper = NAN, band_angle_lower = NAN;  // degrees
+  bool pair = false;
   int band_particles = 0;
   long steps = 0;
   long max_substeps = 0;
 };
 
-// Principal axis of the cloud of nodes with eps_vp_eq >= 50 % of the maximum (CASES.md §1.3).
-void band_angle(const Snapshot& s, SampleResult& r) {
-  const double emax = *std::max_element(s.eps.begin(), s.eps.end());
+// Principal axis (angle to the horizontal, degrees) of the nodes selected by `keep`, and the
+// distance of the imperfection centre (0.04, 1.0) from that axis.
+template <class Keep>
+std::pair<double, double> principal_axis(const Snapshot& s, Keep&& keep, int& count) {
   double mx = 0.0, my = 0.0;
-  int n = 0;
+  count = 0;
   for (std::size_t i = 0; i < s.x.size(); ++i) {
-    if (s.eps[i] < 0.5 * emax) continue;
+    if (!keep(i)) continue;
     mx += s.x[i];
     my += s.y[i];
-    ++n;
+    ++count;
   }
-  mx /= n;
-  my /= n;
+  if (count < 2) return {NAN, NAN};
+  mx /= count;
+  my /= count;
   double cxx = 0.0, cyy = 0.0, cxy = 0.0;
   for (std::size_t i = 0; i < s.x.size(); ++i) {
-    if (s.eps[i] < 0.5 * emax) continue;
+    if (!keep(i)) continue;
     cxx += (s.x[i] - mx) * (s.x[i] - mx);
     cyy += (s.y[i] - my) * (s.y[i] - my);
     cxy += (s.x[i] - mx) * (s.y[i] - my);
   }
   const double theta = 0.5 * std::atan2(2.0 * cxy, cxx - cyy);  // major axis, (-90, 90] deg
-  r.band_angle = std::abs(theta) * 180.0 / std::numbers::pi;
-  r.band_particles = n;
-  // Distance of the imperfection centre (0.04, 1.0) from the band axis through (mx, my).
   const double ux = std::cos(theta), uy = std::sin(theta);
-  r.band_offset = std::abs((0.04 - mx) * uy - (1.0 - my) * ux);
+  return {std::abs(theta) * 180.0 / std::numbers::pi, std::abs((0.04 - mx) * uy - (1.0 - my) * ux)};
+}
+
+// Band angle (CASES.md §1.3): threshold eps_vp_eq at 50 % of its maximum inside the band
+// region, here the sample without the 0.1 m next to each platen (the platen corners
+// concentrate strain by the boundary, not by the band), and fit the principal axis. A
+// conjugate pair (a "<" or ">" from the imperfection) is fitted arm by arm, the arms being
+// the parts of the cloud above and below its centroid; the whole-cloud axis is also given.
+void band_angle(const Snapshot& s, SampleResult& r) {
+  auto inside = [&](std::size_t i) { return s.y[i] > 0.1 + 1e-9 && s.y[i] < kHeight - 0.1 - 1e-9; };
+  double emax = 0.0;
+  for (std::size_t i = 0; i < s.x.size(); ++i) {
+    if (inside(i)) emax = std::max(emax, s.eps[i]);
+  }
+  auto in_band = [&](std::size_t i) { return inside(i) && s.eps[i] >= 0.5 * emax; };
+  int n = 0;
+  const auto whole = principal_axis(s, in_band, n);
+  r.band_particles = n;
+  r.band_angle_whole = whole.first;
+  double ybar = 0.0;
+  for (std::size_t i = 0; i < s.x.size(); ++i) {
+    if (in_band(i)) ybar += s.y[i] / n;
+  }
+  int nu = 0, nl = 0;
+  const auto upper = principal_axis(s, [&](std::size_t i) { return in_band(i) && s.y[i] >= ybar; }, nu);
+  const auto lower = principal_axis(s, [&](std::size_t i) { return in_band(i) && s.y[i] < ybar; }, nl);
+  r.band_angle_upper = upper.first;
+  r.band_angle_lower = lower.first;
+  r.band_offset = std::min(upper.second, lower.second);
+  // A pair when both arms are inclined alike and the whole cloud is not (a single straight
+  // band gives the same axis for its halves and for the whole).
+  r.pair = std::abs(upper.first - whole.first) > 10.0 && std::abs(upper.first - lower.first) < 15.0;
+  r.band_angle = r.pair ? 0.5 * (upper.first + lower.first) : whole.first;
 }
 
 SampleResult run_sample(const std::string& case_file, double dx, double end_strain,
                         const std::vector<double>& snap_strains, double q_y) {
   const double t_end = kRampTime + (end_strain * kHeight - 0.5 * kPlatenSpeed * kRampTime) / kPlatenSpeed;
-  const std::vector<std::string> set = {
+  std::vector<std::string> set = {
       fmt::format("geometry.spacing={}", dx),
       fmt::format("time.end={}", t_end),
       "output.interval=0",
   };
+  // With dx = 0.04 m there is no node at x = 0.5 m: pin the nearest bottom node instead.
+  if (std::abs(std::remainder(0.5 * kWidth, dx)) > 1e-9) {
+    const double xc = std::floor(0.5 * kWidth / dx) * dx;
+    set.push_back(fmt::format("boundary.1.x=[{},{}]", xc, xc));
+  }
   const CaseDocument doc = load_case_document(case_file, set);
   CaseSetup<2> setup = read_case<2>(doc);
   StaggeredSolver<2> solver(setup);
@@ -249,8 +287,10 @@ CaseReport validate_case03(const Options& opt, const std::string& dir) {
 
   // --quick: dx = 0.04 m (25 x 50); --full: CASES.md dx = 0.02 m and the refinement 0.01 m.
   const double dx = opt.full ? 0.02 : 0.04;
-  const std::vector<double> snaps = {0.03, 0.05, 0.08};
-  SampleResult r = run_sample(case_file, dx, 0.08, snaps, q_y);
+  // --quick ends at 5 % axial strain to fit CI; --full runs to CASES.md's 8 %.
+  const double end_strain = opt.full ? 0.08 : 0.05;
+  const std::vector<double> snaps = opt.full ? std::vector<double>{0.03, 0.05, 0.08} : std::vector<double>{0.03, 0.05};
+  SampleResult r = run_sample(case_file, dx, end_strain, snaps, q_y);
   write_history(fmt::format("{}/history_dx{}.csv", dir, dx), r);
   write_snapshots(fmt::format("{}/snapshots_dx{}.csv", dir, dx), r);
   {
@@ -274,9 +314,16 @@ CaseReport validate_case03(const Options& opt, const std::string& dir) {
     rep.metrics.push_back(m);
   }
   rep.metrics.push_back(metric("axial strain at peak (eps_a,y = 1.21 %)", 100 * r.strain_peak, "", 0, "%"));
-  rep.metrics.push_back(metric("softening: q at 8 % / peak q", r.q_end / r.q_peak, "<=", 0.99, ""));
-  rep.metrics.push_back(metric("band angle to the horizontal at 8 % (lower bound)", r.band_angle, ">=", 43.0, "deg"));
-  rep.metrics.push_back(metric("band angle to the horizontal at 8 % (upper bound)", r.band_angle, "<=", 68.0, "deg"));
+  rep.metrics.push_back(metric("softening: q " + fmt::format("at {:.0f} %", 100 * end_strain) + " / peak q", r.q_end / r.q_peak, "<=", 0.99, ""));
+  const std::string at_end = fmt::format("at {:.0f} %", 100 * end_strain);
+  rep.metrics.push_back(metric("band angle to the horizontal " + at_end + " (lower bound)", r.band_angle, ">=", 43.0, "deg"));
+  rep.metrics.push_back(metric("band angle to the horizontal " + at_end + " (upper bound)", r.band_angle, "<=", 68.0, "deg"));
+  rep.metrics.push_back(metric("band: upper arm angle", r.band_angle_upper, "", 0, "deg"));
+  rep.metrics.push_back(metric("band: lower arm angle", r.band_angle_lower, "", 0, "deg"));
+  rep.metrics.push_back(metric("band: whole-cloud principal axis angle", r.band_angle_whole, "", 0, "deg"));
+  rep.notes.push_back(r.pair ? "the band is a conjugate pair from the imperfection; its angle is the mean of the two arms' "
+                               "principal axes (CASES.md §1.3 applied arm by arm)"
+                             : "the band is a single band; its angle is the principal axis of the thresholded cloud");
   rep.metrics.push_back(metric("distance of the band axis from the imperfection centre", r.band_offset, "", 0, "m"));
   rep.metrics.push_back(metric("particles in the band (eps >= 50 % max)", r.band_particles, "", 0, ""));
   rep.metrics.push_back(metric("average q at 6 % strain", r.q_at_6 / 1e3, "", 0, "kPa"));
@@ -286,8 +333,10 @@ CaseReport validate_case03(const Options& opt, const std::string& dir) {
     rep.metrics.push_back(metric("refinement dx 0.02 -> 0.01: band angle change", std::abs(f.band_angle - r.band_angle), "<=", 5.0, "deg"));
     rep.metrics.push_back(metric("refinement dx 0.02 -> 0.01: relative change of q at 6 %",
                                  std::abs(f.q_at_6 / r.q_at_6 - 1.0), "<=", 0.10, ""));
-    rep.notes.push_back(fmt::format("dx = 0.01: peak q {:.1f} kPa at {:.3f} %, band angle {:.1f} deg, q(6 %) {:.1f} kPa",
-                                    f.q_peak / 1e3, 100 * f.strain_peak, f.band_angle, f.q_at_6 / 1e3));
+    rep.notes.push_back(fmt::format("dx = 0.01: peak q {:.1f} kPa at {:.3f} %, band angle {:.1f} deg (arms {:.1f} / {:.1f}, "
+                                    "whole cloud {:.1f}), q(6 %) {:.1f} kPa",
+                                    f.q_peak / 1e3, 100 * f.strain_peak, f.band_angle, f.band_angle_upper,
+                                    f.band_angle_lower, f.band_angle_whole, f.q_at_6 / 1e3));
   }
   std::string note;
   if (opt.plots && run_plot_script("plot_case03.py", dir, note)) {

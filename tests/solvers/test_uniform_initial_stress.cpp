@@ -1,0 +1,156 @@
+// initial_stress type = "uniform" (case_reader / StaggeredSolver::set_initial_state): an
+// isotropic uniform stress with the matching confining tractions stays uniform, and the 1D
+// uniaxial-stress condition runs with the bar modulus E.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <unistd.h>
+
+#include "case/case_setup.hpp"
+#include "core/error.hpp"
+#include "solvers/staggered_solver.hpp"
+
+namespace rktsph {
+namespace {
+
+template <int Dim>
+CaseSetup<Dim> setup_from(const std::string& text, const std::string& tag) {
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("rktsph_uniform_" + tag + "_" + std::to_string(::getpid()) + ".toml");
+  {
+    std::ofstream f(path);
+    f << text;
+  }
+  const CaseDocument doc = load_case_document(path.string(), {});
+  std::filesystem::remove(path);
+  return read_case<Dim>(doc);
+}
+
+const std::string kSample2D = R"(
+[geometry]
+dimension = 2
+spacing = 0.1
+[[geometry.block]]
+min = [0.0, 0.0]
+max = [1.0, 2.0]
+[material]
+model = "perzyna_cam_clay"
+E = 2.0e7
+nu = 0.3
+density = 2000.0
+M = 1.2
+lambda = 0.2
+kappa = 0.02
+e0 = 1.0
+p_c0 = 4.0e5
+fluidity = 10.0
+[initial_stress]
+type = "uniform"
+xx = -5.0e4
+yy = -5.0e4
+zz = -5.0e4
+[[boundary]]
+name = "bottom"
+y = [0.0, 0.0]
+velocity = { y = 0.0 }
+[[boundary]]
+name = "top"
+y = [2.0, 2.0]
+velocity = { y = 0.0 }
+[[boundary]]
+name = "pin"
+x = [0.5, 0.5]
+y = [0.0, 0.0]
+velocity = { x = 0.0 }
+[[boundary]]
+name = "left"
+x = [0.0, 0.0]
+stress = { xx = -5.0e4 }
+[[boundary]]
+name = "right"
+x = [1.0, 1.0]
+stress = { xx = -5.0e4 }
+[time]
+end = 1.0
+cfl = 0.5
+)";
+
+TEST(UniformInitialStress, IsotropicConfinementStaysUniform) {
+  CaseSetup<2> setup = setup_from<2>(kSample2D, "2d");
+  StaggeredSolver<2> solver(setup);
+  constexpr int NV = StaggeredSolver<2>::NV;
+  const double s0[4] = {-5.0e4, -5.0e4, -5.0e4, 0.0};
+  for (int n = 0; n < 500; ++n) solver.step();
+  const auto& phi = solver.node_phi();
+  const std::size_t nn = phi.size() / NV;
+  double ds = 0.0, v = 0.0;
+  for (std::size_t i = 0; i < nn; ++i) {
+    for (int c = 0; c < 2; ++c) v = std::max(v, std::abs(phi[i * NV + static_cast<std::size_t>(c)]));
+    for (int c = 0; c < 4; ++c) ds = std::max(ds, std::abs(phi[i * NV + 2 + static_cast<std::size_t>(c)] - s0[c]));
+  }
+  EXPECT_LT(ds / 5.0e4, 1e-9);
+  EXPECT_LT(v, 1e-12);
+  // p_c is the given p_c0 everywhere and no flow occurred inside the surface (OCR 8).
+  const auto& names = solver.history_names();
+  for (std::size_t j = 0; j < names.size(); ++j) {
+    const int sl = solver.history_slot(0, j);
+    for (std::size_t i = 0; i < nn; ++i) {
+      const double k = solver.node_history()[i * static_cast<std::size_t>(solver.history_stride()) + static_cast<std::size_t>(sl)];
+      EXPECT_EQ(k, names[j] == "p_c" ? 4.0e5 : 0.0) << names[j];
+    }
+  }
+}
+
+TEST(UniformInitialStress, UnknownTypeAndConditionIn2DAreErrors) {
+  std::string bad = kSample2D;
+  bad.replace(bad.find("spacing = 0.1"), 13, "spacing = 0.1\ncondition = \"uniaxial_stress\"");
+  EXPECT_THROW(setup_from<2>(bad, "cond2d"), InputError);
+}
+
+TEST(UniaxialStressCondition, BarUsesModulusE) {
+  const std::string bar = R"(
+[geometry]
+dimension = 1
+spacing = 0.1
+condition = "uniaxial_stress"
+[[geometry.block]]
+min = [0.0]
+max = [1.0]
+[material]
+model = "elastic"
+E = 1.0e7
+nu = 0.3
+density = 2000.0
+[[boundary]]
+name = "fixed"
+x = [0.0, 0.0]
+velocity = { x = 0.0 }
+[time]
+end = 1.0
+cfl = 0.5
+)";
+  CaseSetup<1> setup = setup_from<1>(bar, "bar");
+  StaggeredSolver<1> solver(setup);
+  // Bar wave speed sqrt(E/rho), not the P-wave speed of uniaxial strain.
+  EXPECT_NEAR(solver.max_wave_speed(), std::sqrt(1.0e7 / 2000.0), 1e-9);
+  // A velocity field v = a x gives sigma_xx rate E a and no lateral stress.
+  auto& phi = solver.mutable_node_phi();
+  constexpr int NV = StaggeredSolver<1>::NV;
+  const auto& nodes = solver.particles().nodes;
+  for (std::size_t i = 0; i < phi.size() / NV; ++i) phi[i * NV] = 1e-3 * nodes.position[i][0];
+  solver.step();
+  for (std::size_t i = 0; i < phi.size() / NV; ++i) {
+    EXPECT_EQ(solver.node_phi()[i * NV + 2], 0.0);
+    EXPECT_EQ(solver.node_phi()[i * NV + 3], 0.0);
+  }
+  const std::size_t mid = 5;
+  EXPECT_NEAR(solver.node_phi()[mid * NV + 1], 1.0e7 * 1e-3 * solver.dt(), 1e-6 * 1.0e7 * 1e-3 * solver.dt());
+}
+
+}  // namespace
+}  // namespace rktsph
