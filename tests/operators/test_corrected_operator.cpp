@@ -9,6 +9,8 @@
 #include <functional>
 #include <random>
 
+#include <fmt/format.h>
+
 #include "core/kernel.hpp"
 #include "geometry/particles.hpp"
 #include "operators/corrected_operator.hpp"
@@ -108,7 +110,7 @@ TEST_P(Operator1D, ExactForConstantAndLinearBothDirections) {
     EXPECT_LT(ec.grad, kTol);
     EXPECT_LT(el.interp, kTol);
     EXPECT_LT(el.grad, kTol);
-    RecordProperty(to_elements ? "linear_grad_err_en" : "linear_grad_err_ne", std::to_string(el.grad));
+    RecordProperty(to_elements ? "linear_grad_err_en" : "linear_grad_err_ne", fmt::format("{:.3g}", el.grad));
   }
   // The end node x = 0 has only elements on one side (truncated support): check it alone.
   const auto end = apply_errors<1>(ne, disc.nodes.position, disc.elements, lin, glin, scale,
@@ -154,7 +156,7 @@ TEST_P(Operator2D, ExactForConstantAndLinearBothDirections) {
     EXPECT_LT(el.grad, kTol);
     worst = std::max({worst, el.interp, el.grad});
   }
-  RecordProperty("linear_worst_relative_error", std::to_string(worst));
+  RecordProperty("linear_worst_relative_error", fmt::format("{:.3g}", worst));
   // Truncated supports: corners and edge midpoints of the body, checked on their own.
   const double tol_corner = 0.3 * dx;
   auto on_corner = [&](const Vec<2>& x) {
@@ -218,7 +220,7 @@ TEST(CorrectedOperator, QuadraticIsNotReproducedButErrorIsSmall) {
     const auto e = apply_errors<2>(en, disc.elements.position, disc.nodes, quad, gquad, scale, interior);
     EXPECT_GT(e.interp, 1e-4);  // ~ second moment of the kernel, (h^2) / |f|
     EXPECT_LT(e.interp, 1e-1);
-    RecordProperty("quadratic_interp_err_regular", std::to_string(e.interp));
+    RecordProperty("quadratic_interp_err_regular", fmt::format("{:.3g}", e.interp));
   }
   std::mt19937 rng(7);
   jitter(disc.nodes.position, 0.2 * dx, rng);
@@ -228,7 +230,7 @@ TEST(CorrectedOperator, QuadraticIsNotReproducedButErrorIsSmall) {
   EXPECT_GT(e.grad, 1e-6);
   EXPECT_LT(e.grad, 0.1);
   EXPECT_GT(e.interp, 1e-5);
-  RecordProperty("quadratic_grad_err_jittered", std::to_string(e.grad));
+  RecordProperty("quadratic_grad_err_jittered", fmt::format("{:.3g}", e.grad));
 }
 
 // ---- difference-form gradient (fix (a) of METHOD.md §0.3) ----
@@ -270,7 +272,7 @@ TEST(DifferenceGradient, ExactForLinearFieldWithExactFhat) {
     }
     EXPECT_LT(worst, 1e-12) << (jittered ? "jittered" : "regular");
     EXPECT_GT(worst_wrong_fhat, 0.1);
-    RecordProperty(jittered ? "diff_grad_err_jittered" : "diff_grad_err_regular", std::to_string(worst));
+    RecordProperty(jittered ? "diff_grad_err_jittered" : "diff_grad_err_regular", fmt::format("{:.3g}", worst));
   }
 }
 
