@@ -308,8 +308,16 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
       }
       st->finish();
     }
-    if (spec.velocity.empty() && spec.stress.empty()) {
-      b.fail("", "prescribes nothing: give a velocity = {...} or stress = {...} table");
+    // V3 pore-pressure conditions (checked against solver.version below).
+    if (b.has("pore_pressure")) spec.pore_pressure = b.number("pore_pressure");
+    else b.number("pore_pressure", 0.0);
+    spec.impermeable = b.boolean("impermeable", false);
+    if (spec.pore_pressure && spec.impermeable) {
+      b.fail("impermeable", "a face is either drained (pore_pressure) or impermeable, not both");
+    }
+    if (spec.velocity.empty() && spec.stress.empty() && !spec.pore_pressure && !spec.impermeable) {
+      b.fail("", "prescribes nothing: give a velocity = {...} or stress = {...} table (or, with "
+                 "solver.version = \"v3\", pore_pressure or impermeable)");
     }
     spec.function = function_index(c, b, "function");
     b.finish();
@@ -385,9 +393,21 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
   // ---- solver
   if (auto s = root.optional_table("solver")) {
     const std::string version = s->string("version", "v1");
-    if (version != "v1") {
-      s->fail("version", fmt::format("unknown solver version '{}' (available: v1)", version));
+    if (version == "v3") {
+      c.saturated = true;  // the v-p_w model (METHOD.md §1.4, §2.4, §5.3)
+    } else if (version != "v1") {
+      s->fail("version", fmt::format("unknown solver version '{}' (available: v1, v3)", version));
     }
+    // V3 pressure solve (METHOD.md §2.4 "Solver"); read for every version, used by v3 only.
+    const std::string pc = s->string("pressure_preconditioner", "jacobi");
+    if (pc == "jacobi") c.fluid.incomplete_cholesky = false;
+    else if (pc == "incomplete_cholesky") c.fluid.incomplete_cholesky = true;
+    else s->fail("pressure_preconditioner", fmt::format("unknown preconditioner '{}' (known: jacobi, incomplete_cholesky)", pc));
+    c.fluid.tolerance = s->positive("pressure_tolerance", 1e-8);
+    s->require(c.fluid.tolerance < 1e-2, "pressure_tolerance", "must be < 1e-2");
+    c.fluid.max_iterations = static_cast<int>(s->integer("pressure_max_iterations", 2000));
+    s->require(c.fluid.max_iterations >= 1, "pressure_max_iterations", "must be >= 1");
+    c.fluid.deferred_correction = s->boolean("pressure_deferred_correction", true);
     const std::string scheme = s->string("scheme", "staggered");
     if (scheme == "staggered") c.scheme = Scheme::staggered;
     else if (scheme == "collocated") c.scheme = Scheme::collocated;
@@ -401,6 +421,41 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     else if (coupling == "frozen_flux") c.coupling = SourceCoupling::frozen_flux;
     else s->fail("source_coupling", fmt::format("unknown source coupling '{}' (known: additive, frozen_flux)", coupling));
     s->finish();
+  }
+
+  // ---- V3: the pore fluid (docs/case-format.md, "Saturated soil (V3)")
+  if (auto f = root.optional_table("fluid")) {
+    if (!c.saturated) f->fail("porosity", "a [fluid] table needs solver.version = \"v3\"");
+    FluidSpec& fl = c.fluid;
+    fl.porosity = f->positive("porosity");
+    f->require(fl.porosity < 1.0, "porosity", fmt::format("must lie in (0, 1), got {}", fl.porosity));
+    fl.density = f->positive("density");
+    fl.bulk_modulus = f->positive("bulk_modulus");
+    fl.grain_bulk_modulus = f->non_negative("grain_bulk_modulus", 0.0);
+    fl.conductivity = f->number("conductivity");
+    f->require(fl.conductivity >= 0.0, "conductivity", "must be >= 0 (m/s)");
+    fl.gravity = f->positive("gravity", 9.81);
+    fl.saturation = f->positive("saturation", 1.0);
+    f->require(fl.saturation <= 1.0, "saturation", fmt::format("must lie in (0, 1], got {}", fl.saturation));
+    fl.initial_pore_pressure = f->number("initial_pore_pressure", 0.0);
+    // The material density is the mixture density; the implied grain density must be physical.
+    for (std::size_t m = 0; m < c.materials.size(); ++m) {
+      const double rho = c.materials[m]->density();
+      const double rho_s = (rho - fl.porosity * fl.density) / (1.0 - fl.porosity);
+      f->require(rho_s >= fl.density, "density",
+                 fmt::format("material '{}': the mixture density {} kg/m^3 with porosity {} and fluid "
+                             "density {} kg/m^3 implies a grain density of {:.4g} kg/m^3, lighter than "
+                             "the fluid (the material density is the MIXTURE density n rho_f + (1-n) rho_s)",
+                             c.material_names[m], rho, fl.porosity, fl.density, rho_s));
+    }
+    f->finish();
+  } else if (c.saturated) {
+    root.fail("fluid", "missing: solver.version = \"v3\" needs a [fluid] table");
+  }
+  for (const auto& b : c.boundaries) {
+    if (!c.saturated && (b.pore_pressure || b.impermeable)) {
+      throw InputError(fmt::format("{}: pore_pressure / impermeable need solver.version = \"v3\"", b.where));
+    }
   }
 
   // ---- output and probes

@@ -15,6 +15,12 @@
 
 namespace rktsph {
 
+namespace {
+// Below this many nodes a loop runs on one thread (as in staggered_solver.cpp): the fork/join
+// costs more than it saves.
+constexpr Index kParallelMinV3 = 2048;
+}  // namespace
+
 template <int Dim>
 void StaggeredSolver<Dim>::build_saturated() {
   saturated_ = true;
@@ -83,7 +89,7 @@ void StaggeredSolver<Dim>::pressure_step(double t_new) {
   const auto* wg = op_nn_.grad.data();
   double* phi = node_phi_.data();
   // RHS_I = p^n_I/(Q* dt) - S_w (div v*)_I; drained nodes take their value at t^{n+1}.
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nn > kParallelMinV3)
   for (Index i = 0; i < nn; ++i) {
     const auto iu = static_cast<std::size_t>(i);
     double div = 0.0;
@@ -96,7 +102,7 @@ void StaggeredSolver<Dim>::pressure_step(double t_new) {
   }
   pressure_->solve(pw_source_, pw_old_, pw_);
   // Velocity correction v^{n+1} = v* - (dt/rho) grad p^{n+1} (same-set corrected gradient).
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nn > kParallelMinV3)
   for (Index i = 0; i < nn; ++i) {
     const auto iu = static_cast<std::size_t>(i);
     double g[Dim] = {};

@@ -162,6 +162,7 @@ StaggeredSolver<Dim>::StaggeredSolver(CaseSetup<Dim>& setup)
 template <int Dim>
 void StaggeredSolver<Dim>::build_constraints() {
   const auto nn = static_cast<std::size_t>(disc_.nodes.size());
+  if (setup.saturated) build_saturated();  // V3: pore pressure (staggered_saturated.cpp)
   std::vector<std::vector<NodalConstraint>> per_node(nn);
   std::vector<std::uint8_t> velocity_set(nn, 0);
   const double tol = 1e-6 * setup_.dx + 1e-12;
@@ -284,7 +285,7 @@ void StaggeredSolver<Dim>::apply_constraints(double t) {
     for (Index k = constraint_row_[static_cast<std::size_t>(i)]; k < constraint_row_[static_cast<std::size_t>(i) + 1]; ++k) {
       const NodalConstraint& c = constraints_[static_cast<std::size_t>(k)];
       node_phi_[static_cast<std::size_t>(i) * NV + static_cast<std::size_t>(c.component)] =
-          c.value * setup_.function_value(c.function, t);
+          constraint_value(static_cast<std::size_t>(i), c, t);  // V3: sigma' = sigma + p_w
     }
   }
 }
@@ -357,6 +358,12 @@ void StaggeredSolver<Dim>::step_elements(double t) {
         src_rate_[eu * NS + static_cast<std::size_t>(s)] = dsig[s];
       }
     }
+    if (saturated_) {  // V3 (METHOD.md §5.3): -grad p^n / rho in the element half-step
+      for (Index k = row[e]; k < row[e + 1]; ++k) {
+        const double pr = pw_[static_cast<std::size_t>(src[k])] / disc_.elements.density[eu];
+        for (int d = 0; d < Dim; ++d) dv[d] -= wg[k][static_cast<std::size_t>(d)] * pr;
+      }
+    }
     if (stride > 0) {
       // History variables are interpolated from the nodes (METHOD.md §3.3: nodes are primary).
       double* ks = &elem_state_[eu * static_cast<std::size_t>(stride)];
@@ -401,7 +408,7 @@ void StaggeredSolver<Dim>::step_nodes(double t) {
       const auto dr = static_cast<std::size_t>(drow);
       for (Index q = constraint_row_[iu]; q < constraint_row_[iu + 1]; ++q) {
         const NodalConstraint& con = constraints_[static_cast<std::size_t>(q)];
-        const double fhat = con.value * setup_.function_value(con.function, t_half);
+        const double fhat = constraint_value(iu, con, t_half);
         double g[Dim] = {};
         for (Index k = diff_ne_.row_start[dr]; k < diff_ne_.row_start[dr + 1]; ++k) {
           const double f = ephi[static_cast<std::size_t>(diff_ne_.source[static_cast<std::size_t>(k)]) * NV +
@@ -492,7 +499,11 @@ double StaggeredSolver<Dim>::boundary_power() const {
         if (((faces >> (2 * d + side)) & 1u) == 0) continue;
         const double normal = side == 0 ? -1.0 : 1.0;
         const double area = disc_.boundary.area[iu][static_cast<std::size_t>(2 * d + side)];
-        for (int k = 0; k < Dim; ++k) power += area * phi[Dim + slot<Dim>(k, d)] * normal * phi[k];
+        for (int k = 0; k < Dim; ++k) {
+          // V3: the traction is the total stress sigma' - p_w 1.
+          const double sk = phi[Dim + slot<Dim>(k, d)] - (saturated_ && k == d ? pw_[iu] : 0.0);
+          power += area * sk * normal * phi[k];
+        }
       }
     }
   }
@@ -576,6 +587,10 @@ EnergyBalance StaggeredSolver<Dim>::energy() const {
   for (std::size_t i = 0; i < nn; ++i) {
     const double* phi = &node_phi_[i * NV];
     const double m = disc_.nodes.mass(static_cast<Index>(i));
+  if (saturated_) {  // V3: pressure solve and velocity correction (METHOD.md §2.4 steps 2-3)
+    pressure_step(t + dt_);
+    apply_constraints(t + dt_);
+  }
     for (int d = 0; d < Dim; ++d) e.kinetic += 0.5 * m * phi[d] * phi[d];
     const Sym6 s = to_sym6<Dim>(phi + Dim);
     const Sym6 eps = materials_[static_cast<std::size_t>(disc_.nodes.material[i])]->elastic().apply_inverse(s);
@@ -601,6 +616,7 @@ std::size_t StaggeredSolver<Dim>::state_bytes() const {
   bytes += (disc_.nodes.material.size() + disc_.elements.material.size()) * sizeof(int);
   return bytes;
 }
+    if (saturated_) w += inv_storage_ * pw_[i] * pw_[i];  // V3: fluid storage p^2/(2Q*)
 
 template <int Dim>
 std::size_t StaggeredSolver<Dim>::operator_bytes() const {

@@ -34,6 +34,8 @@ int run_validation(const Options& opt) {
       {"01", validate_case01},
       {"02", validate_case02},
       {"03", validate_case03},
+      {"13", validate_case13},
+      {"14", validate_case14},
   };
   fs::create_directories(opt.out_dir);
   std::vector<CaseReport> reports;

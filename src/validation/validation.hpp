@@ -72,6 +72,8 @@ using CaseRunner = std::function<CaseReport(const Options&, const std::string& c
 CaseReport validate_case01(const Options& options, const std::string& case_dir);
 CaseReport validate_case02(const Options& options, const std::string& case_dir);
 CaseReport validate_case03(const Options& options, const std::string& case_dir);
+CaseReport validate_case13(const Options& options, const std::string& case_dir);
+CaseReport validate_case14(const Options& options, const std::string& case_dir);
 
 /// Run the selected cases and write out_dir/report.md. Returns 0 if all pass, 1 otherwise.
 int run_validation(const Options& options);

@@ -1,0 +1,220 @@
+// V3 saturated solver (METHOD.md §2.4, §5.3; CASES.md C4): the pressure matrix is symmetric
+// positive definite with a Dirichlet row, the PCG reaches the requested tolerance with both
+// preconditioners, the undrained limit (k -> 0) gives p0 = q Q/(M+Q) and the undrained
+// settlement, the time step is the drained skeleton's, and the drained limit (k -> infinity)
+// reduces to the V1 solver.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+
+#include <Eigen/Dense>
+#include <fmt/format.h>
+
+#include "../support/test_util.hpp"
+#include "core/kernel.hpp"
+#include "operators/laplacian.hpp"
+#include "solvers/pore_pressure.hpp"
+#include "solvers/staggered_solver.hpp"
+
+namespace rktsph {
+namespace {
+
+ParticleSet<2> grid(int n, int m, double dx) {
+  ParticleSet<2> s;
+  for (int j = 0; j <= m; ++j) {
+    for (int i = 0; i <= n; ++i) {
+      s.position.emplace_back(i * dx, j * dx);
+      const double fx = (i == 0 || i == n) ? 0.5 : 1.0, fy = (j == 0 || j == m) ? 0.5 : 1.0;
+      s.volume.push_back(fx * fy * dx * dx);
+      s.density.push_back(1700.0);
+      s.material.push_back(0);
+    }
+  }
+  return s;
+}
+
+PorePressureSolver::Settings settings(double inv_q_dt, PressurePreconditioner pc) {
+  PorePressureSolver::Settings s;
+  s.inv_q_dt = inv_q_dt;
+  s.k_eff = 3e-7;
+  s.tolerance = 1e-10;
+  s.preconditioner = pc;
+  s.deferred_correction = false;
+  return s;
+}
+
+TEST(PorePressure, MatrixIsSymmetricPositiveDefiniteWithADirichletRow) {
+  const auto s = grid(10, 8, 0.1);
+  const auto lap = build_node_laplacian<2>(s, CubicSplineKernel<2>(0.12));
+  std::vector<bool> drained(static_cast<std::size_t>(s.size()), false);
+  for (std::size_t i = 0; i < drained.size(); ++i) drained[i] = s.position[i][1] > 0.8 - 1e-9;  // top row
+  // Incompressible fluid (1/Q* = 0): only the Dirichlet row makes K definite.
+  for (double inv_q_dt : {0.0, 1e-5}) {
+    PorePressureSolver solver(lap.full, lap.symmetric, drained, settings(inv_q_dt, PressurePreconditioner::diagonal));
+    EXPECT_EQ(solver.unknowns(), 11 * 8);
+    const Eigen::MatrixXd K = Eigen::MatrixXd(solver.matrix());
+    EXPECT_LT((K - K.transpose()).norm(), 1e-14 * K.norm());
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(K);
+    EXPECT_GT(eig.eigenvalues().minCoeff(), 0.0) << "1/(Q dt) = " << inv_q_dt;
+    const Eigen::LLT<Eigen::MatrixXd> llt(K);
+    EXPECT_EQ(llt.info(), Eigen::Success);
+  }
+  // Without any Dirichlet row and with 1/Q* = 0, K is singular (constant null vector): the
+  // check above can fail.
+  std::vector<bool> none(drained.size(), false);
+  PorePressureSolver floating(lap.full, lap.symmetric, none, settings(0.0, PressurePreconditioner::diagonal));
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(Eigen::MatrixXd(floating.matrix()));
+  EXPECT_LT(std::abs(eig.eigenvalues().minCoeff()), 1e-10 * eig.eigenvalues().maxCoeff());
+}
+
+TEST(PorePressure, ConjugateGradientReachesTheRequestedTolerance) {
+  const auto s = grid(20, 16, 0.05);
+  const auto lap = build_node_laplacian<2>(s, CubicSplineKernel<2>(0.06));
+  std::vector<bool> drained(static_cast<std::size_t>(s.size()), false);
+  for (std::size_t i = 0; i < drained.size(); ++i) drained[i] = s.position[i][1] > 0.8 - 1e-9;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  std::vector<double> source(drained.size()), p_old(drained.size(), 0.0);
+  for (double& v : source) v = u(rng);
+  for (auto pc : {PressurePreconditioner::diagonal, PressurePreconditioner::incomplete_cholesky}) {
+    PorePressureSolver solver(lap.full, lap.symmetric, drained, settings(1e-6, pc));
+    std::vector<double> p(drained.size(), 0.0);  // drained value 0
+    solver.solve(source, p_old, p);
+    // Independent residual over the free nodes: K x - b with b = source (drained values 0).
+    Eigen::VectorXd x(solver.unknowns()), b(solver.unknowns());
+    Index r = 0;
+    for (std::size_t i = 0; i < drained.size(); ++i) {
+      if (drained[i]) continue;
+      x[r] = p[i];
+      b[r] = source[i];
+      ++r;
+    }
+    const double rel = (Eigen::VectorXd(solver.matrix() * x) - b).norm() / b.norm();
+    EXPECT_LE(rel, 1e-10 * 1.01);
+    EXPECT_GT(solver.stats().last_iterations, 0);
+    EXPECT_LE(solver.stats().last_error, 1e-10);
+  }
+}
+
+// The 1D column of CASES.md Case 13 (H = 10 m unless given), as a V3 case.
+std::string column(double H, double dx, double conductivity, const std::string& load, double end,
+                   const std::string& top_pressure = "pore_pressure = 0.0",
+                   const std::string& base_pressure = "impermeable = true") {
+  return fmt::format(R"(
+[geometry]
+dimension = 1
+spacing = {dx}
+[[geometry.block]]
+min = [0.0]
+max = [{H}]
+[material]
+model = "elastic"
+E = 3.0e7
+nu = 0.2
+density = 1700.0
+[fluid]
+porosity = 0.3
+density = 1000.0
+bulk_modulus = 1.0e8
+conductivity = {k}
+[solver]
+version = "v3"
+[functions.load]
+{load}
+[[boundary]]
+name = "base"
+x = [0.0, 0.0]
+velocity = {{ x = 0.0 }}
+{base}
+[[boundary]]
+name = "top"
+x = [{H}, {H}]
+stress = {{ xx = -5.0e3 }}
+{top}
+function = "load"
+[time]
+end = {end}
+cfl = 0.5
+)",
+                     fmt::arg("dx", dx), fmt::arg("H", H), fmt::arg("k", conductivity), fmt::arg("load", load),
+                     fmt::arg("end", end), fmt::arg("top", top_pressure), fmt::arg("base", base_pressure));
+}
+
+constexpr double kM = 3.0e7 * 0.8 / (1.2 * 0.6), kQ = 1.0e8 / 0.3, kRho = 1700.0;
+
+TEST(Saturated, UndrainedLimitGivesTheUndrainedResponse) {
+  test::ThreadCount one(1);
+  test::TempDir dir;
+  // k = 0 and no drained face: the load, a total stress on the (impermeable) top, is carried by
+  // the pore pressure p0 = q Q/(M+Q) and the skeleton q M/(M+Q) (CASES.md Case 13). (A drained
+  // top with k = 0 is singular: p jumps from p0 to 0 there, and the scheme spreads the jump
+  // over a few dx.)
+  auto setup = test::case_from_string<1>(
+      dir, column(10.0, 0.1, 0.0, "type = \"ramp\"\nduration = 2.0", 3.0, "impermeable = true"));
+  StaggeredSolver<1> solver(setup);
+  // The time step is the drained skeleton's: C dx / sqrt(M/rho), not the undrained sqrt((M+Q)/rho).
+  EXPECT_NEAR(solver.dt(), 0.5 * 0.1 / std::sqrt(kM / kRho), 1e-12);
+  EXPECT_NEAR(solver.max_wave_speed(), std::sqrt(kM / kRho), 1e-9);
+  const auto& nodes = solver.particles().nodes;
+  std::size_t mid = 0, top = 0;
+  for (std::size_t i = 0; i < static_cast<std::size_t>(nodes.size()); ++i) {
+    if (std::abs(nodes.position[i][0] - 5.0) < 1e-9) mid = i;
+    if (std::abs(nodes.position[i][0] - 10.0) < 1e-9) top = i;
+  }
+  double p_sum = 0.0, s_sum = 0.0;
+  long count = 0;
+  while (solver.time() < 3.0 - 1e-9) {
+    solver.step();
+    if (solver.time() >= 2.0) {  // time average over 1 s removes the free vibration
+      p_sum += solver.node_pore_pressure()[mid];
+      s_sum += -solver.node_displacement()[top];
+      ++count;
+    }
+  }
+  const double p0 = 5.0e3 * kQ / (kM + kQ), s0 = 5.0e3 * 10.0 / (kM + kQ);
+  EXPECT_NEAR(p_sum / static_cast<double>(count), p0, 0.01 * p0);
+  EXPECT_NEAR(s_sum / static_cast<double>(count), s0, 0.03 * s0);
+  EXPECT_NEAR(solver.node_pore_pressure()[top], p0, 0.05 * p0);
+  // The effective stress carries the rest, q M/(M+Q).
+  constexpr int NV = StaggeredSolver<1>::NV;
+  EXPECT_NEAR(solver.node_phi()[mid * NV + 1], -5.0e3 * kM / (kM + kQ), 0.1 * 5.0e3 * kM / (kM + kQ));
+}
+
+TEST(Saturated, DrainedLimitReducesToV1) {
+  test::ThreadCount one(1);
+  test::TempDir dir;
+  // A 1 m column drained at both ends, smooth load; V1 with the same (mixture) density.
+  const std::string load = "type = \"smoothstep\"\nduration = 0.02";
+  const double end = 0.05;
+  auto run = [&](const std::string& text, bool v3) {
+    auto setup = test::case_from_string<1>(dir, text, {}, v3 ? "v3.toml" : "v1.toml");
+    StaggeredSolver<1> solver(setup);
+    while (solver.time() < end - 1e-12) solver.step();
+    std::vector<double> out;
+    constexpr int NV = StaggeredSolver<1>::NV;
+    for (std::size_t i = 0; i < static_cast<std::size_t>(solver.particles().nodes.size()); ++i) {
+      out.push_back(solver.node_phi()[i * NV + 1]);  // sigma'_xx (V3) or sigma_xx (V1)
+    }
+    return out;
+  };
+  std::string v1 = column(1.0, 0.05, 0.0, load, end, "", "");
+  v1.replace(v1.find("[fluid]"), v1.find("[functions.load]") - v1.find("[fluid]"), "");
+  // (the [fluid] and [solver] tables are gone: a V1 case)
+  const auto ref = run(v1, false);
+  double scale = 0.0;
+  for (double v : ref) scale = std::max(scale, std::abs(v));
+  double previous = 1e300;
+  for (double k : {0.1, 1.0, 10.0}) {
+    const auto sat = run(column(1.0, 0.05, k, load, end, "pore_pressure = 0.0", "pore_pressure = 0.0"), true);
+    double diff = 0.0;
+    for (std::size_t i = 0; i < ref.size(); ++i) diff = std::max(diff, std::abs(sat[i] - ref[i]));
+    diff /= scale;
+    EXPECT_LT(diff, previous) << "k = " << k;  // the difference falls as k grows
+    previous = diff;
+  }
+  EXPECT_LT(previous, 0.01);
+}
+
+}  // namespace
+}  // namespace rktsph
