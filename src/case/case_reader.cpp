@@ -252,6 +252,11 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
   if (auto d = root.optional_table("damping")) {
     c.damping = d->non_negative("coefficient", 0.0);
     c.damping_until = d->non_negative("until", std::numeric_limits<double>::infinity());
+    c.damping_until_kinetic_ratio = d->non_negative("until_kinetic_ratio", 0.0);
+    d->require(c.damping_until_kinetic_ratio < 1.0, "until_kinetic_ratio",
+               fmt::format("must lie in [0, 1) (a fraction of the peak kinetic energy), got {}",
+                           c.damping_until_kinetic_ratio));
+    c.damping_ratio_from = d->non_negative("kinetic_ratio_from", 0.0);
     d->finish();
   }
 

@@ -34,6 +34,9 @@ int run_validation(const Options& opt) {
       {"01", validate_case01},
       {"02", validate_case02},
       {"03", validate_case03},
+      {"04", validate_case04},
+      {"05", validate_case05},
+      {"06", validate_case06},
       {"13", validate_case13},
       {"14", validate_case14},
   };

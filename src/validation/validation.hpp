@@ -72,6 +72,9 @@ using CaseRunner = std::function<CaseReport(const Options&, const std::string& c
 CaseReport validate_case01(const Options& options, const std::string& case_dir);
 CaseReport validate_case02(const Options& options, const std::string& case_dir);
 CaseReport validate_case03(const Options& options, const std::string& case_dir);
+CaseReport validate_case04(const Options& options, const std::string& case_dir);
+CaseReport validate_case05(const Options& options, const std::string& case_dir);
+CaseReport validate_case06(const Options& options, const std::string& case_dir);
 CaseReport validate_case13(const Options& options, const std::string& case_dir);
 CaseReport validate_case14(const Options& options, const std::string& case_dir);
 

@@ -1,0 +1,269 @@
+// Thesis case 4: elastic vertical cut (CASES.md Case 4). (a) the group's set-up, gravity ramp
+// with damping, against the FE reference points, the exact section equilibrium and the
+// traction-free faces; (b) the exactly solvable variant (nu = 0, smooth base, sudden gravity)
+// against its closed form over two periods.
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "validation/cut_common.hpp"
+#include "validation/validation.hpp"
+
+namespace rktsph::validation {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr double kRho = 2000.0, kG = 9.81, kE = 8.0e7, kH = 10.0, kW = 10.0;
+constexpr double kGammaH = kRho * kG * kH;  // rho g H = 196.2 kPa
+
+struct RefPoint {
+  double x, y, sxx, syy, sxy;  // kPa
+};
+// CASES.md Case 4(a): 9-node FE reference (kPa).
+constexpr RefPoint kRefPoints[] = {
+    {0.0, 5.0, -19.3, -101.2, 0.0}, {5.0, 5.0, -11.8, -102.3, -1.6}, {9.9, 5.0, 0.0, -76.9, -0.6},
+    {0.0, 1.0, -68.0, -175.0, 0.0}, {5.0, 1.0, -62.6, -175.3, 14.4},
+};
+
+struct CaseA {
+  double stress_err = 0.0;    // max |sigma - ref| / (rho g H) over the points and components
+  double disp_err = 0.0;      // max relative displacement error
+  double section_err = 0.0;   // max relative section-resultant error
+  double face_res = 0.0, top_res = 0.0;  // / (rho g H)
+  double ke_end = 0.0, ke_peak = 0.0;
+  double vmax_end = 0.0, vmax_x = 0.0, vmax_y = 0.0;
+  double seconds = 0.0;
+  long steps = 0;
+};
+
+CaseA run_a(const std::string& file, double dx, const std::string& dir, std::vector<std::string>& notes) {
+  const CutRun r = run_cut(file, {fmt::format("geometry.spacing={}", dx), "output.interval=0"}, 0.01);
+  CaseA a;
+  a.seconds = r.seconds;
+  a.steps = r.steps;
+  if (!r.error.empty()) {
+    notes.push_back(fmt::format("4(a) dx = {} m stopped: {}", dx, r.error));
+    a.stress_err = a.disp_err = a.section_err = NAN;
+    return a;
+  }
+  const CutSnapshot& s = r.final_state;
+  std::ofstream pts(fs::path(dir) / fmt::format("a_points_dx{}.csv", dx));
+  pts << "x,y,component,reference_kPa,computed_kPa\n";
+  for (const auto& p : kRefPoints) {
+    const double c[3] = {bilinear(s, s.sxx, dx, p.x, p.y) / 1e3, bilinear(s, s.syy, dx, p.x, p.y) / 1e3,
+                         bilinear(s, s.sxy, dx, p.x, p.y) / 1e3};
+    const double ref[3] = {p.sxx, p.syy, p.sxy};
+    const char* names[3] = {"sxx", "syy", "sxy"};
+    for (int k = 0; k < 3; ++k) {
+      a.stress_err = std::max(a.stress_err, std::abs(c[k] - ref[k]) * 1e3 / kGammaH);
+      pts << fmt::format("{},{},{},{},{:.4f}\n", p.x, p.y, names[k], ref[k], c[k]);
+    }
+  }
+  // Displacements (CASES.md): settlements at the top, outward face displacement.
+  struct Disp {
+    const char* name;
+    double x, y, ref;
+    bool horizontal;
+  };
+  const Disp disps[] = {{"top settlement at x = 0", 0.0, kH, 1.019e-2, false},
+                        {"top settlement at the crest", kW, kH, 0.998e-2, false},
+                        {"face u_x at the crest", kW, kH, 1.76e-3, true},
+                        {"face u_x at mid-height", kW, 0.5 * kH, 3.58e-3, true}};
+  std::ofstream dsp(fs::path(dir) / fmt::format("a_displacements_dx{}.csv", dx));
+  dsp << "point,reference_m,computed_m\n";
+  for (const auto& d : disps) {
+    const double v = d.horizontal ? at_node(s, s.ux, d.x, d.y) : -at_node(s, s.uy, d.x, d.y);
+    a.disp_err = std::max(a.disp_err, std::abs(v - d.ref) / d.ref);
+    dsp << fmt::format("{},{},{:.6g}\n", d.name, d.ref, v);
+  }
+  // Section resultants: trapezoidal sum of nodal sigma_yy along each node row.
+  std::ofstream sec(fs::path(dir) / fmt::format("a_sections_dx{}.csv", dx));
+  sec << "y,resultant_kN,exact_kN\n";
+  for (double y = 0.0; y < kH - 0.5 * dx; y += dx) {
+    std::vector<double> xs, fs_;
+    row_profile(s, s.syy, y, dx, xs, fs_);
+    double sum = 0.0;
+    for (std::size_t k = 0; k + 1 < xs.size(); ++k) sum += 0.5 * (fs_[k] + fs_[k + 1]) * (xs[k + 1] - xs[k]);
+    const double exact = -kRho * kG * kW * (kH - y);
+    a.section_err = std::max(a.section_err, std::abs(sum - exact) / std::abs(exact));
+    sec << fmt::format("{},{:.6g},{:.6g}\n", y, sum / 1e3, exact / 1e3);
+  }
+  a.face_res = r.face_residual / kGammaH;
+  a.top_res = r.top_residual / kGammaH;
+  a.ke_end = r.ke.back();
+  a.ke_peak = r.peak_ke;
+  for (std::size_t i = 0; i < s.x.size(); ++i) {
+    const double v = std::hypot(s.vx[i], s.vy[i]);
+    if (v > a.vmax_end) {
+      a.vmax_end = v;
+      a.vmax_x = s.x[i];
+      a.vmax_y = s.y[i];
+    }
+  }
+  write_snapshot_csv((fs::path(dir) / fmt::format("a_final_dx{}.csv", dx)).string(), s);
+  write_history_csv((fs::path(dir) / fmt::format("a_history_dx{}.csv", dx)).string(), r);
+  return a;
+}
+
+// Closed forms of CASES.md Case 4(b), u_y positive up (the top settles: negative).
+double exact_base_stress(double t) {
+  const double c = std::sqrt(kE / kRho), T = 4.0 * kH / c;
+  const double tau = std::fmod(t, T);
+  return tau <= 2.0 * kH / c ? -kRho * kG * c * tau : -kRho * kG * (4.0 * kH - c * tau);
+}
+double exact_top_uy(double t) {
+  const double c = std::sqrt(kE / kRho), a = kH / c;
+  const double tau = std::fmod(t, 4.0 * a);
+  if (tau <= a) return -0.5 * kG * tau * tau;
+  if (tau <= 3.0 * a) return -kRho * kG * kH * kH / kE + 0.5 * kG * (tau - 2.0 * a) * (tau - 2.0 * a);
+  return -0.5 * kG * (4.0 * a - tau) * (4.0 * a - tau);
+}
+
+struct CaseB {
+  double base_err = 0.0, top_err = 0.0, ux_ratio = 0.0, uniformity = 0.0;
+  double seconds = 0.0;
+  long steps = 0;
+};
+
+CaseB run_b(const std::string& file, double dx, const std::string& dir) {
+  const double xs[3] = {1.0, 5.0, 9.75};
+  std::vector<std::size_t> base(3), top(3), face;
+  std::vector<std::vector<std::size_t>> rows(4);  // nodes of y = 0, 2.5, 5, 7.5
+  const double c = std::sqrt(kE / kRho);
+  bool init = false;
+  CaseB b;
+  double max_uy = 0.0, max_ux = 0.0;
+  std::ofstream f(fs::path(dir) / fmt::format("b_history_dx{}.csv", dx));
+  f << "t,syy_exact,syy_x1,syy_x5,syy_x9.75,uy_exact,uy_x1,uy_x5,uy_x9.75,ux_face_max\n";
+  constexpr int NV = StaggeredSolver<2>::NV;
+  auto hook = [&](const StaggeredSolver<2>& solver) {
+    const auto& nodes = solver.particles().nodes;
+    const auto nn = static_cast<std::size_t>(nodes.size());
+    if (!init) {
+      for (int k = 0; k < 3; ++k) {
+        double d0 = 1e300, d1 = 1e300;
+        for (std::size_t i = 0; i < nn; ++i) {
+          const auto& p = nodes.position[i];
+          const double db = std::hypot(p[0] - xs[k], p[1]), dt_ = std::hypot(p[0] - xs[k], p[1] - kH);
+          if (db < d0 - 1e-9) { d0 = db; base[static_cast<std::size_t>(k)] = i; }
+          if (dt_ < d1 - 1e-9) { d1 = dt_; top[static_cast<std::size_t>(k)] = i; }
+        }
+      }
+      for (std::size_t i = 0; i < nn; ++i) {
+        const auto& p = nodes.position[i];
+        if (std::abs(p[0] - kW) < 1e-9) face.push_back(i);
+        for (std::size_t k = 0; k < 4; ++k) {
+          if (std::abs(p[1] - 2.5 * static_cast<double>(k)) < 1e-9) rows[k].push_back(i);
+        }
+      }
+      init = true;
+    }
+    const double t = solver.time();
+    const double se = exact_base_stress(t), ue = exact_top_uy(t);
+    // Exclude +-2 steps around the slope reversals of the base stress, t = k 2H/c.
+    const double rev = 2.0 * kH / c;
+    const bool near_rev = std::abs(t - rev * std::round(t / rev)) <= 2.0 * solver.dt() + 1e-12;
+    double sv[3], uv[3];
+    for (std::size_t k = 0; k < 3; ++k) {
+      sv[k] = solver.node_phi()[base[k] * NV + 3];
+      uv[k] = solver.node_displacement()[top[k] * 2 + 1];
+      if (!near_rev) b.base_err = std::max(b.base_err, std::abs(sv[k] - se) / (2.0 * kGammaH));
+      b.top_err = std::max(b.top_err, std::abs(uv[k] - ue) / (kGammaH * kH / kE));
+    }
+    double ux = 0.0;
+    for (std::size_t i : face) ux = std::max(ux, std::abs(solver.node_displacement()[2 * i]));
+    for (std::size_t i = 0; i < static_cast<std::size_t>(nodes.size()); ++i) {
+      max_uy = std::max(max_uy, std::abs(solver.node_displacement()[2 * i + 1]));
+    }
+    max_ux = std::max(max_ux, ux);
+    for (const auto& row : rows) {
+      double lo = 1e300, hi = -1e300;
+      for (std::size_t i : row) {
+        lo = std::min(lo, solver.node_phi()[i * NV + 3]);
+        hi = std::max(hi, solver.node_phi()[i * NV + 3]);
+      }
+      b.uniformity = std::max(b.uniformity, (hi - lo) / kGammaH);
+    }
+    f << fmt::format("{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{:.6g}\n", t, se, sv[0], sv[1],
+                     sv[2], ue, uv[0], uv[1], uv[2], ux);
+  };
+  const CutRun r = run_cut(file, {fmt::format("geometry.spacing={}", dx), "output.interval=0"}, 1.0, 0.0, hook);
+  b.ux_ratio = max_uy > 0.0 ? max_ux / max_uy : NAN;
+  if (!r.error.empty()) b.base_err = b.top_err = NAN;
+  b.seconds = r.seconds;
+  b.steps = r.steps;
+  return b;
+}
+
+}  // namespace
+
+CaseReport validate_case04(const Options& opt, const std::string& dir) {
+  CaseReport rep;
+  rep.id = "04";
+  rep.title = "Elastic vertical cut (V1)";
+  rep.reference = "CASES.md Case 4: (a) 9-node FE reference points and exact equilibrium checks; "
+                  "(b) closed form of the nu = 0 block under sudden gravity";
+  const std::string file_a = (fs::path(opt.cases_dir) / "04a_elastic_cut_2d.toml").string();
+  const std::string file_b = (fs::path(opt.cases_dir) / "04b_elastic_cut_closed_form_2d.toml").string();
+
+  // (a) at CASES.md's dx = 0.5 m and the repeat at 0.25 m (both cheap: run in both modes).
+  for (double dx : {0.5, 0.25}) {
+    const CaseA a = run_a(file_a, dx, dir, rep.notes);
+    const std::string tag = fmt::format("(a) dx = {} m: ", dx);
+    rep.metrics.push_back(metric(tag + "control-point stress error, max over 5 points x 3 components / rho g H",
+                                 a.stress_err, "<=", 0.05, ""));
+    rep.metrics.push_back(metric(tag + "displacement error (settlements, face u_x), max relative", a.disp_err, "<=",
+                                 0.05, ""));
+    rep.metrics.push_back(metric(tag + "section resultant error, max over node rows y < H, relative", a.section_err,
+                                 "<=", 0.01, ""));
+    rep.metrics.push_back(metric(tag + "traction residual on the face (stress points extrapolated) / rho g H",
+                                 a.face_res, "<=", 0.02, ""));
+    rep.metrics.push_back(metric(tag + "traction residual on the top (stress points extrapolated) / rho g H",
+                                 a.top_res, "<=", 0.02, ""));
+    rep.metrics.push_back(metric(tag + "kinetic energy at t = 2 s / its peak (METHOD.md §0.3 item 8)",
+                                 a.ke_peak > 0 ? a.ke_end / a.ke_peak : NAN, "", 0.0, ""));
+    rep.notes.push_back(fmt::format("(a) dx = {} m: {} steps, {:.1f} s; at t = 2 s kinetic energy {:.3g} J/m (peak "
+                                    "{:.3g}), largest |v| = {:.3g} m/s at ({}, {}) m",
+                                    dx, a.steps, a.seconds, a.ke_end, a.ke_peak, a.vmax_end, a.vmax_x, a.vmax_y));
+  }
+  rep.notes.push_back("(a) particles do not move in V1, so the tensile-instability clumping at the top corner "
+                      "cannot occur (METHOD.md §0.3 item 6); the stress at the crest node is in a_final_dx*.csv");
+
+  // (b) over two periods at 0.5, 0.25 and the acceptance resolution 0.125 m.
+  for (double dx : {0.5, 0.25, 0.125}) {
+    const CaseB b = run_b(file_b, dx, dir);
+    const bool accept = dx < 0.2;
+    const std::string tag = fmt::format("(b) dx = {} m: ", dx);
+    rep.metrics.push_back(metric(tag + "base sigma_yy error / (2 rho g H), max over x = 1, 5, 9.75 m and t (±2 steps "
+                                 "of the reversals excluded)",
+                                 b.base_err, accept ? "<=" : "", 0.03, ""));
+    rep.metrics.push_back(metric(tag + "top u_y error / (rho g H^2/E), max over x = 1, 5, 9.75 m and t", b.top_err,
+                                 accept ? "<=" : "", 0.03, ""));
+    rep.metrics.push_back(metric(tag + "spurious face u_x / max|u_y|", b.ux_ratio, accept ? "<=" : "", 0.02, ""));
+    rep.metrics.push_back(metric(tag + "sigma_yy spread across x at y = 0, 2.5, 5, 7.5 m / rho g H", b.uniformity,
+                                 accept ? "<=" : "", 0.03, ""));
+    rep.notes.push_back(fmt::format("(b) dx = {} m: {} steps, {:.1f} s{}", dx, b.steps, b.seconds,
+                                    dx > 0.4 ? " (x = 9.75 m is not a node at this spacing: the nearest node is used)"
+                                             : ""));
+  }
+  if (opt.plots) {
+    std::string note;
+    if (run_plot_script("plot_case04.py", dir, note)) {
+      for (const char* p : {"case04/a_stress_profiles.png", "case04/a_sections.png", "case04/a_deformed.png",
+                            "case04/b_base_stress.png", "case04/b_top_uy.png", "case04/b_face_ux.png"}) {
+        rep.plots.push_back(p);
+      }
+    } else {
+      rep.notes.push_back(note);
+    }
+  }
+  return rep;
+}
+
+}  // namespace rktsph::validation
