@@ -398,6 +398,12 @@ int run_dim(const RunOptions& opt, const CaseDocument& doc) {
   }
   std::ofstream(out / "summary.json") << summary.dump(2) << "\n";
   if (!opt.quiet) {
+    if (const PressureSolveStats* ps = solver.pressure_stats()) {
+      std::cerr << fmt::format("pore pressure: {} PCG solves, iterations mean {:.1f} / max {}, final relative "
+                               "residual {:.2e}; pressure step {:.0f} % of the loop time\n",
+                               ps->solves, ps->mean_iterations(), ps->max_iterations, ps->last_error,
+                               loop_seconds > 0 ? 100.0 * solver.pressure_step_seconds() / loop_seconds : 0.0);
+    }
     if (exit_code == 0) {
       std::cerr << fmt::format("done: {} steps in {:.2f} s ({:.3g} node-steps/s); output in {}\n",
                                solver.step_count(), loop_seconds,
