@@ -146,7 +146,7 @@ CaseReport validate_case15(const Options& opt, const std::string& dir) {
       hist << fmt::format("{:.5g},{:.6e},{:.6e},{:.6g}\n", solver.time(), sc, -solver.node_displacement()[edge * 2 + 1], pmax / kSigma0);
       if (solver.time() > 2.0) drop = std::max(drop, last - sc);  // consolidation settlement must not decrease
       last = sc;
-      if (std::abs(solver.time() - 15.0) < 0.5 * every * solver.dt()) checker = checkerboard(solver, dx);
+      if (std::abs(solver.time() - 15.0) < 0.5 * static_cast<double>(every) * solver.dt()) checker = checkerboard(solver, dx);
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     double pmax = 0.0;
