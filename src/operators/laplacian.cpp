@@ -12,7 +12,9 @@ namespace rktsph {
 template <int Dim>
 NodeLaplacian<Dim> build_node_laplacian(const ParticleSet<Dim>& nodes,
                                         const CubicSplineKernel<Dim>& kernel,
-                                        const std::vector<std::uint8_t>& wall_axes) {
+                                        const std::vector<std::uint8_t>& wall_axes,
+                                        const std::vector<MirrorPlane>& mirrors,
+                                        const std::vector<std::uint8_t>& mirror_mask) {
   using Triplet = Eigen::Triplet<double>;
   const auto n = static_cast<std::size_t>(nodes.size());
   const CellList<Dim> cells(nodes.position, kernel.support_radius());
@@ -33,6 +35,23 @@ NodeLaplacian<Dim> build_node_laplacian(const ParticleSet<Dim>& nodes,
     cells.for_each_neighbour(xi, [&](Index j, const Vec<Dim>& x_ij, double r) {
       if (static_cast<std::size_t>(j) != i && r > 0.0) pairs[i].push_back({j, x_ij, r});
     });
+    // Mirror images across the impermeable walls within reach (even extension, p_J' = p_J).
+    for (std::size_t k = 0; k < mirrors.size() && k < 8; ++k) {
+      if (!mirror_mask.empty() && ((mirror_mask[i] >> k) & 1u) == 0) continue;
+      const MirrorPlane& m = mirrors[k];
+      const double dist = (m.coord - xi[m.axis]) * m.outward;  // >= 0 inside the body
+      if (dist < -1e-9 * kernel.h() || dist >= kernel.support_radius()) continue;
+      Vec<Dim> image = xi;  // the sources near the image of I are the images of I's partners
+      image[m.axis] = 2.0 * m.coord - xi[m.axis];
+      cells.for_each_neighbour(image, [&](Index j, const Vec<Dim>&, double) {
+        Vec<Dim> xj = nodes.position[static_cast<std::size_t>(j)];
+        if ((m.coord - xj[m.axis]) * m.outward < -1e-9 * kernel.h()) return;  // not in this body half
+        xj[m.axis] = 2.0 * m.coord - xj[m.axis];
+        const Vec<Dim> x_ij = xi - xj;
+        const double r = x_ij.norm();
+        if (r > 1e-12 * kernel.h() && r < kernel.support_radius()) pairs[i].push_back({j, x_ij, r});
+      });
+    }
     std::sort(pairs[i].begin(), pairs[i].end(), [](const Pair& a, const Pair& b) { return a.j < b.j; });
     Mat<Dim> A = Mat<Dim>::Zero();
     Vec<Dim> g = Vec<Dim>::Zero();
@@ -88,8 +107,10 @@ NodeLaplacian<Dim> build_node_laplacian(const ParticleSet<Dim>& nodes,
 }
 
 template NodeLaplacian<1> build_node_laplacian<1>(const ParticleSet<1>&, const CubicSplineKernel<1>&,
+                                                  const std::vector<std::uint8_t>&, const std::vector<MirrorPlane>&,
                                                   const std::vector<std::uint8_t>&);
 template NodeLaplacian<2> build_node_laplacian<2>(const ParticleSet<2>&, const CubicSplineKernel<2>&,
+                                                  const std::vector<std::uint8_t>&, const std::vector<MirrorPlane>&,
                                                   const std::vector<std::uint8_t>&);
 
 }  // namespace rktsph

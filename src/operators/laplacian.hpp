@@ -33,6 +33,15 @@
 
 namespace rktsph {
 
+/// An impermeable straight wall x_axis = coord, the body on the side opposite to `outward`
+/// (+1: outward normal +e_axis). Neighbours are mirrored across it (even extension, p_J' = p_J,
+/// METHOD.md §4.1), which restores a full support near the wall.
+struct MirrorPlane {
+  int axis = 0;
+  double coord = 0.0;
+  int outward = 1;
+};
+
 template <int Dim>
 struct NodeLaplacian {
   using Sparse = Eigen::SparseMatrix<double, Eigen::RowMajor>;
@@ -44,9 +53,20 @@ struct NodeLaplacian {
 
 /// Build L and S over `nodes`. `wall_axes[I]` (may be empty) holds, per node, bit d set when
 /// the node lies on an impermeable wall with normal e_d (the normal gradient is then zero).
+/// `mirrors` (may be empty): impermeable walls whose mirror images join the sums of every node
+/// within the kernel support of the wall (a neighbour ON the wall is its own image and so
+/// counts twice: it stands for its real and its mirrored half-volume). With mirrors, a row
+/// next to a wall sees a full support: A_I ~ 1 and the isotropic normalisation of Schwaiger's
+/// formula holds, which it does not for a one-sided, anisotropic support (METHOD.md §3.5
+/// table: 2.25 instead of 4 at an edge). Images across two walls (corners) are not added.
+/// `mirror_mask[I]` (may be empty = all) selects, bit k, the planes mirrors[k] used at node I
+/// (at most 8 planes), so that a plane that is impermeable only in part (a footing on a drained
+/// surface) mirrors only where it is a wall.
 template <int Dim>
 NodeLaplacian<Dim> build_node_laplacian(const ParticleSet<Dim>& nodes,
                                         const CubicSplineKernel<Dim>& kernel,
-                                        const std::vector<std::uint8_t>& wall_axes = {});
+                                        const std::vector<std::uint8_t>& wall_axes = {},
+                                        const std::vector<MirrorPlane>& mirrors = {},
+                                        const std::vector<std::uint8_t>& mirror_mask = {});
 
 }  // namespace rktsph

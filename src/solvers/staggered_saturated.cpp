@@ -4,7 +4,9 @@
 // set-up of the pressure equation and the pressure step: div v*, the PCG solve of
 // K p^{n+1} = RHS (solvers/pore_pressure.hpp) and the velocity correction
 // v^{n+1} = v* - (dt/rho) grad p^{n+1}.
+#include <algorithm>
 #include <chrono>
+#include <limits>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -45,20 +47,57 @@ void StaggeredSolver<Dim>::build_saturated() {
       pw_function_[i] = spec.function;
     }
   }
-  std::vector<std::uint8_t> wall_axes(nn, 0);
   for (std::size_t i = 0; i < nn; ++i) {
-    if (pw_drained_[i]) {
-      pw_[i] = pw_value_[i] * setup_.function_value(pw_function_[i], 0.0);
-      continue;
-    }
+    if (pw_drained_[i]) pw_[i] = pw_value_[i] * setup_.function_value(pw_function_[i], 0.0);
+  }
+
+  // Impermeable walls (METHOD.md §4.1, mirror nodes): every face plane of the body that holds
+  // a non-drained boundary node. A node uses a plane when the boundary node nearest to its
+  // projection on that plane is an impermeable node of that face (so a footing on a drained
+  // surface mirrors only under the footing).
+  std::vector<MirrorPlane> planes;
+  const double eps = 1e-6 * setup_.dx;
+  for (std::size_t i = 0; i < nn; ++i) {
     const std::uint8_t faces = disc_.boundary.faces[i];
-    for (int d = 0; d < Dim; ++d) {
-      if ((faces >> (2 * d)) & 3u) wall_axes[i] = static_cast<std::uint8_t>(wall_axes[i] | (1u << d));
+    for (int bit = 0; bit < 2 * Dim; ++bit) {
+      if (((faces >> bit) & 1u) == 0 || pw_drained_[i]) continue;
+      const MirrorPlane m{bit / 2, disc_.nodes.position[i][bit / 2], bit % 2 == 0 ? -1 : 1};
+      const bool known = std::any_of(planes.begin(), planes.end(), [&](const MirrorPlane& q) {
+        return q.axis == m.axis && q.outward == m.outward && std::abs(q.coord - m.coord) < eps;
+      });
+      if (!known) planes.push_back(m);
+    }
+  }
+  if (planes.size() > 8) {
+    throw InputError(fmt::format("{}: the pore-pressure walls lie on {} planes; at most 8 are supported", setup_.file,
+                                 planes.size()));
+  }
+  std::vector<std::uint8_t> mask(nn, 0);
+  const double reach = kernel_.support_radius();
+  for (std::size_t k = 0; k < planes.size(); ++k) {
+    const MirrorPlane& m = planes[k];
+    const int bit = 2 * m.axis + (m.outward > 0 ? 1 : 0);
+    for (std::size_t i = 0; i < nn; ++i) {
+      const Vec<Dim>& x = disc_.nodes.position[i];
+      if (std::abs(x[m.axis] - m.coord) >= reach) continue;
+      Vec<Dim> foot = x;
+      foot[m.axis] = m.coord;
+      std::size_t best = nn;
+      double best_d = std::numeric_limits<double>::infinity();
+      for (std::size_t j = 0; j < nn; ++j) {
+        if (((disc_.boundary.faces[j] >> bit) & 1u) == 0 || std::abs(disc_.nodes.position[j][m.axis] - m.coord) > eps) continue;
+        const double d = (disc_.nodes.position[j] - foot).norm();
+        if (d < best_d) {
+          best_d = d;
+          best = j;
+        }
+      }
+      if (best < nn && best_d < 0.5 * setup_.dx + eps && !pw_drained_[best]) mask[i] = static_cast<std::uint8_t>(mask[i] | (1u << k));
     }
   }
 
   op_nn_ = build_corrected_operator<Dim>(disc_.nodes.position, disc_.nodes, kernel_);
-  const NodeLaplacian<Dim> lap = build_node_laplacian<Dim>(disc_.nodes, kernel_, wall_axes);
+  const NodeLaplacian<Dim> lap = build_node_laplacian<Dim>(disc_.nodes, kernel_, {}, planes, mask);
 
   // K = I/(Q* dt) - k_eff S with k_eff = k_w + S_w dt/rho (METHOD.md §2.4). One mixture density
   // is assumed for the fractional-step term (the densest material: the largest stabilisation is

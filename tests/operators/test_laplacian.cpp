@@ -134,5 +134,32 @@ TEST(Laplacian, WallRowsSeeTheEvenExtension) {
   EXPECT_NEAR(Lf[10], 2.0, 0.01 * 2.0);
 }
 
+TEST(Laplacian, MirrorWallsRestoreTheFullSupportIn2D) {
+  // f = x^2 + y^2 has zero normal derivative on the walls x = 0 and y = 0: with the walls
+  // mirrored, the rows along them (corner excluded: no double images) give 4 like the interior.
+  const double dx = 0.1;
+  const auto s = lattice2(14, 14, dx, 0.0);
+  const CubicSplineKernel<2> kernel(1.2 * dx);
+  const std::vector<MirrorPlane> walls = {{0, 0.0, -1}, {1, 0.0, -1}};
+  const auto lap = build_node_laplacian<2>(s, kernel, {}, walls);
+  const auto plain = build_node_laplacian<2>(s, kernel);
+  const Eigen::VectorXd Lf = lap.full * sample(s, quadratic);
+  const Eigen::VectorXd Pf = plain.full * sample(s, quadratic);
+  double worst = 0.0, worst_plain = 0.0;
+  for (Index i = 0; i < s.size(); ++i) {
+    const Vec<2>& x = s.position[static_cast<std::size_t>(i)];
+    const double far = 1.4 - 2.0 * kernel.h() - 0.5 * dx;
+    if (x[0] > far || x[1] > far) continue;                          // away from the open sides
+    if (x[0] < 2.0 * kernel.h() && x[1] < 2.0 * kernel.h()) continue;  // corner region
+    worst = std::max(worst, std::abs(Lf[i] - 4.0) / 4.0);
+    worst_plain = std::max(worst_plain, std::abs(Pf[i] - 4.0) / 4.0);
+  }
+  EXPECT_LT(worst, 0.01);
+  EXPECT_GT(worst_plain, 0.1);  // without the mirrors the wall rows are far off (METHOD.md §3.5)
+  // The symmetric part stays symmetric with the images.
+  const Eigen::SparseMatrix<double> S = lap.symmetric;
+  EXPECT_LT((S - Eigen::SparseMatrix<double>(S.transpose())).norm(), 1e-12 * S.norm());
+}
+
 }  // namespace
 }  // namespace rktsph
