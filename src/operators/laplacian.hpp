@@ -12,7 +12,9 @@
 // L_II = -sum_J L_IJ (zero row sum). L is exact for linear fields on any particle set whose A_I
 // is invertible, and second-order accurate in the interior of a lattice. It is not symmetric.
 //
-// Neumann (impermeable) walls: at a node on a wall with outward normal n the prescribed normal
+// Neumann (impermeable) walls, two ways. The solver uses MIRROR images (below: `mirrors`), the
+// even extension across straight walls. The simpler `wall_axes` variant (kept for comparison
+// and tested in 1D) only fixes the gradient: at a node on a wall with outward normal n the prescribed normal
 // derivative (zero) replaces the computed one in the correction, i.e. grad f_I is projected on
 // the wall's tangent plane, P = I - n n. The row then evaluates the Laplacian of the even
 // (mirror) extension of f across the wall - the discrete counterpart of dp/dn = 0
