@@ -45,8 +45,11 @@ def histories(d, fig_path, title, pattern_labels, H=10.0):
 
 
 def eps_map(ax, s, title):
-    sc = ax.scatter(s["x"], s["y"], c=s["eps_vp_eq"], s=4, cmap="viridis", marker="s")
-    plt.colorbar(sc, ax=ax, label="accumulated plastic strain $\\bar\\varepsilon^{vp}$ (-)")
+    from matplotlib.colors import LogNorm
+    top = max(s["eps_vp_eq"])
+    vals = [max(e, 1e-3 * top) for e in s["eps_vp_eq"]]
+    sc = ax.tripcolor(s["x"], s["y"], vals, shading="gouraud", cmap="viridis", norm=LogNorm(vmin=1e-3 * top, vmax=top))
+    plt.colorbar(sc, ax=ax, label="accumulated plastic strain $\\bar\\varepsilon^{vp}$ (-, log scale)")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
     ax.set_aspect("equal")

@@ -175,8 +175,10 @@ CutRun run_cut(const std::string& file, const std::vector<std::string>& override
     for (const auto& [row, a] : face1) {
       const auto b = face2.find(row);
       if (b == face2.end()) continue;
-      r.face_residual = std::max({r.face_residual, std::abs(a.first + fx * (a.first - b->second.first)),
-                                  std::abs(a.second + fx * (a.second - b->second.second))});
+      const double res = std::max(std::abs(a.first + fx * (a.first - b->second.first)),
+                                  std::abs(a.second + fx * (a.second - b->second.second)));
+      r.face_residual = std::max(r.face_residual, res);
+      if (0.5 * static_cast<double>(row) * r.dx >= 0.1 * r.height) r.face_residual_above_toe = std::max(r.face_residual_above_toe, res);
     }
     for (const auto& [col, a] : top1) {
       const auto b = top2.find(col);

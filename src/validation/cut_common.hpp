@@ -56,6 +56,8 @@ struct CutRun {
   /// |sigma_xx|, |sigma_xy| on the face (|sigma_yy|, |sigma_xy| on the top), Pa. The nodal
   /// values there are prescribed and exact by construction; these are what the body carries.
   double face_residual = 0.0, top_residual = 0.0;
+  /// The face residual over the rows y >= 0.1 H only (away from the toe corner), Pa.
+  double face_residual_above_toe = 0.0;
   Classification classification;
 };
 
