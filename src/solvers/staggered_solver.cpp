@@ -160,13 +160,13 @@ StaggeredSolver<Dim>::StaggeredSolver(CaseSetup<Dim>& setup)
   elem_runs_ = make_runs(disc_.elements);
 
   build_constraints();
+  if (setup.saturated) build_saturated();  // V3: pore pressure (staggered_saturated.cpp)
   set_initial_state();
 }
 
 template <int Dim>
 void StaggeredSolver<Dim>::build_constraints() {
   const auto nn = static_cast<std::size_t>(disc_.nodes.size());
-  if (setup.saturated) build_saturated();  // V3: pore pressure (staggered_saturated.cpp)
   std::vector<std::vector<NodalConstraint>> per_node(nn);
   // Bit k * Dim + d: v_k is prescribed at the node by an entry acting on the face with normal
   // e_d (an entry whose box is a plane x_d = const; a box that is no plane acts on every face).
@@ -381,6 +381,12 @@ void StaggeredSolver<Dim>::step_elements(double t) {
     const auto m = static_cast<std::size_t>(disc_.elements.material[eu]);
     double dv[Dim], dsig[NS];
     flux_rates<Dim>(grad, 1.0 / disc_.elements.density[eu], lambda_[m], shear_[m], dv, dsig);
+    if (saturated_) {  // V3 (METHOD.md §5.3): -grad p^n / rho in the element half-step
+      for (Index k = row[e]; k < row[e + 1]; ++k) {
+        const double pr = pw_[static_cast<std::size_t>(src[k])] / disc_.elements.density[eu];
+        for (int d = 0; d < Dim; ++d) dv[d] -= w[k][static_cast<std::size_t>(d) + 1] * pr;
+      }
+    }
     double* out = &elem_phi_[eu * NV];
     for (int i = 0; i < Dim; ++i) out[i] = damped_velocity(bar[i], dv[i] + b[i], cd, tau);
     for (int s = 0; s < NS; ++s) out[Dim + s] = bar[Dim + s] + tau * dsig[s];
@@ -388,12 +394,6 @@ void StaggeredSolver<Dim>::step_elements(double t) {
       for (int s = 0; s < NS; ++s) {
         src_sigma_start_[eu * NS + static_cast<std::size_t>(s)] = bar[Dim + s];
         src_rate_[eu * NS + static_cast<std::size_t>(s)] = dsig[s];
-      }
-    }
-    if (saturated_) {  // V3 (METHOD.md §5.3): -grad p^n / rho in the element half-step
-      for (Index k = row[e]; k < row[e + 1]; ++k) {
-        const double pr = pw_[static_cast<std::size_t>(src[k])] / disc_.elements.density[eu];
-        for (int d = 0; d < Dim; ++d) dv[d] -= wg[k][static_cast<std::size_t>(d)] * pr;
       }
     }
     if (stride > 0) {
@@ -610,6 +610,10 @@ void StaggeredSolver<Dim>::step() {
   step_elements(t);
   step_nodes(t);
   apply_constraints(t + dt_);
+  if (saturated_) {  // V3: pressure solve and velocity correction (METHOD.md §2.4 steps 2-3)
+    pressure_step(t + dt_);
+    apply_constraints(t + dt_);
+  }
   if (setup_.filter) {
     filter_velocity();
     apply_constraints(t + dt_);
@@ -626,16 +630,13 @@ EnergyBalance StaggeredSolver<Dim>::energy() const {
   for (std::size_t i = 0; i < nn; ++i) {
     const double* phi = &node_phi_[i * NV];
     const double m = disc_.nodes.mass(static_cast<Index>(i));
-  if (saturated_) {  // V3: pressure solve and velocity correction (METHOD.md §2.4 steps 2-3)
-    pressure_step(t + dt_);
-    apply_constraints(t + dt_);
-  }
     for (int d = 0; d < Dim; ++d) e.kinetic += 0.5 * m * phi[d] * phi[d];
     const Sym6 s = to_sym6<Dim>(phi + Dim);
     const Sym6 eps = materials_[static_cast<std::size_t>(disc_.nodes.material[i])]->elastic().apply_inverse(s);
     double w = 0.0;
     for (std::size_t c = 0; c < 3; ++c) w += s[c] * eps[c];
     for (std::size_t c = 3; c < 6; ++c) w += 2.0 * s[c] * eps[c];
+    if (saturated_) w += inv_storage_ * pw_[i] * pw_[i];  // V3: fluid storage p^2/(2Q*)
     e.strain += 0.5 * disc_.nodes.volume[i] * w;
   }
   e.external_work = external_work_;
@@ -655,7 +656,6 @@ std::size_t StaggeredSolver<Dim>::state_bytes() const {
   bytes += (disc_.nodes.material.size() + disc_.elements.material.size()) * sizeof(int);
   return bytes;
 }
-    if (saturated_) w += inv_storage_ * pw_[i] * pw_[i];  // V3: fluid storage p^2/(2Q*)
 
 template <int Dim>
 std::size_t StaggeredSolver<Dim>::operator_bytes() const {
