@@ -321,7 +321,7 @@ std::string run_note(const std::string& label, const CutRun& r) {
                      label, r.dx, r.steps, r.dt, r.seconds, outcome_name(r.classification.outcome),
                      r.classification.uc_end, r.classification.uc_change, 1e-3 * r.height, r.classification.ke_ratio,
                      std::isfinite(r.damping_off_time) ? fmt::format("t = {:.2f} s", r.damping_off_time)
-                                                      : std::string("no time (kinetic energy never decayed)"),
+                                                      : std::string("damping.until (the kinetic-energy switch did not fire)"),
                      r.error.empty() ? "" : "; stopped: " + r.error);
 }
 
