@@ -107,7 +107,9 @@ TEST(Laplacian, SymmetricPartIsSymmetricWithZeroRowSums) {
   // Off-diagonal entries non-negative: a weighted graph Laplacian (negative semi-definite).
   for (int k = 0; k < lap.symmetric.outerSize(); ++k) {
     for (NodeLaplacian<2>::Sparse::InnerIterator it(lap.symmetric, k); it; ++it) {
-      if (it.row() != it.col()) EXPECT_GE(it.value(), 0.0);
+      if (it.row() != it.col()) {
+        EXPECT_GE(it.value(), 0.0);
+      }
     }
   }
 }
