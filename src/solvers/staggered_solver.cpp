@@ -54,6 +54,8 @@ inline void flux_rates(const double (&grad)[Dim][kStateComponents<Dim>], double 
 }
 
 constexpr Index kReductionBlock = 4096;  // fixed blocks: sums independent of the thread count
+// Below this many particles a loop runs on one thread: the fork/join costs more than it saves.
+constexpr Index kParallelMin = 2048;
 
 }  // namespace
 
@@ -328,7 +330,7 @@ void StaggeredSolver<Dim>::integrate_sources(double tau, bool on_elements) {
   std::vector<double>& phi = on_elements ? elem_phi_ : node_phi_;
   std::vector<double>& state = on_elements ? elem_state_ : node_state_;
   long max_sub = max_substeps_;
-#pragma omp parallel for schedule(dynamic) reduction(max : max_sub)
+#pragma omp parallel for schedule(dynamic) reduction(max : max_sub) if (runs.size() > 4)
   for (std::size_t r = 0; r < runs.size(); ++r) {
     const auto [m, begin, end] = runs[r];
     const auto b0 = static_cast<std::size_t>(begin);
@@ -362,19 +364,21 @@ void StaggeredSolver<Dim>::step_elements(double t) {
   const Index ne = disc_.elements.size();
   const Index* row = op_en_.row_start.data();
   const Index* src = op_en_.source.data();
-  const auto* w = op_en_.weight.data();
+  const double* wi = op_en_.interp.data();
+  const auto* wg = op_en_.grad.data();
   const double* nphi = node_phi_.data();
   const int stride = state_stride_;
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (ne > kParallelMin)
   for (Index e = 0; e < ne; ++e) {
     double bar[NV] = {};
     double grad[Dim][NV] = {};
     for (Index k = row[e]; k < row[e + 1]; ++k) {
       const double* p = nphi + static_cast<std::size_t>(src[k]) * NV;
-      const auto& wk = w[k];
+      const double w0 = wi[k];
+      const auto& wk = wg[k];
       for (int c = 0; c < NV; ++c) {
-        bar[c] += wk[0] * p[c];
-        for (int d = 0; d < Dim; ++d) grad[d][c] += wk[static_cast<std::size_t>(d) + 1] * p[c];
+        bar[c] += w0 * p[c];
+        for (int d = 0; d < Dim; ++d) grad[d][c] += wk[static_cast<std::size_t>(d)] * p[c];
       }
     }
     const auto eu = static_cast<std::size_t>(e);
@@ -384,7 +388,7 @@ void StaggeredSolver<Dim>::step_elements(double t) {
     if (saturated_) {  // V3 (METHOD.md §5.3): -grad p^n / rho in the element half-step
       for (Index k = row[e]; k < row[e + 1]; ++k) {
         const double pr = pw_[static_cast<std::size_t>(src[k])] / disc_.elements.density[eu];
-        for (int d = 0; d < Dim; ++d) dv[d] -= w[k][static_cast<std::size_t>(d) + 1] * pr;
+        for (int d = 0; d < Dim; ++d) dv[d] -= wg[k][static_cast<std::size_t>(d)] * pr;
       }
     }
     double* out = &elem_phi_[eu * NV];
@@ -402,7 +406,7 @@ void StaggeredSolver<Dim>::step_elements(double t) {
       for (int j = 0; j < stride; ++j) ks[j] = 0.0;
       for (Index k = row[e]; k < row[e + 1]; ++k) {
         const double* kn = &node_state_[static_cast<std::size_t>(src[k]) * static_cast<std::size_t>(stride)];
-        for (int j = 0; j < stride; ++j) ks[j] += w[k][0] * kn[j];
+        for (int j = 0; j < stride; ++j) ks[j] += wi[k] * kn[j];
       }
     }
   }
@@ -420,16 +424,16 @@ void StaggeredSolver<Dim>::step_nodes(double t) {
   const Index nn = disc_.nodes.size();
   const Index* row = op_ne_.row_start.data();
   const Index* src = op_ne_.source.data();
-  const auto* w = op_ne_.weight.data();
+  const auto* wg = op_ne_.grad.data();
   const double* ephi = elem_phi_.data();
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nn > kParallelMin)
   for (Index i = 0; i < nn; ++i) {
     double grad[Dim][NV] = {};
     for (Index k = row[i]; k < row[i + 1]; ++k) {
       const double* p = ephi + static_cast<std::size_t>(src[k]) * NV;
-      const auto& wk = w[k];
+      const auto& wk = wg[k];
       for (int c = 0; c < NV; ++c) {
-        for (int d = 0; d < Dim; ++d) grad[d][c] += wk[static_cast<std::size_t>(d) + 1] * p[c];
+        for (int d = 0; d < Dim; ++d) grad[d][c] += wk[static_cast<std::size_t>(d)] * p[c];
       }
     }
     const auto iu = static_cast<std::size_t>(i);
@@ -477,11 +481,11 @@ void StaggeredSolver<Dim>::filter_velocity() {
   const Index nn = disc_.nodes.size();
   const double eps = setup_.filter_strength;
   auto to_elements = [&](const double* node_field, std::size_t node_stride) {
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (ne > kParallelMin)
     for (Index e = 0; e < ne; ++e) {
       double acc[Dim] = {};
       for (Index k = op_en_.row_start[static_cast<std::size_t>(e)]; k < op_en_.row_start[static_cast<std::size_t>(e) + 1]; ++k) {
-        const double wk = op_en_.weight[static_cast<std::size_t>(k)][0];
+        const double wk = op_en_.interp[static_cast<std::size_t>(k)];
         const double* p = node_field + static_cast<std::size_t>(op_en_.source[static_cast<std::size_t>(k)]) * node_stride;
         for (int d = 0; d < Dim; ++d) acc[d] += wk * p[d];
       }
@@ -491,13 +495,13 @@ void StaggeredSolver<Dim>::filter_velocity() {
   auto back_to_nodes = [&](Index i, double* acc) {
     for (int d = 0; d < Dim; ++d) acc[d] = 0.0;
     for (Index k = op_ne_.row_start[static_cast<std::size_t>(i)]; k < op_ne_.row_start[static_cast<std::size_t>(i) + 1]; ++k) {
-      const double wk = op_ne_.weight[static_cast<std::size_t>(k)][0];
+      const double wk = op_ne_.interp[static_cast<std::size_t>(k)];
       const double* p = &filter_elem_[static_cast<std::size_t>(op_ne_.source[static_cast<std::size_t>(k)]) * Dim];
       for (int d = 0; d < Dim; ++d) acc[d] += wk * p[d];
     }
   };
   to_elements(node_phi_.data(), NV);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nn > kParallelMin)
   for (Index i = 0; i < nn; ++i) {
     double acc[Dim];
     back_to_nodes(i, acc);
@@ -507,7 +511,7 @@ void StaggeredSolver<Dim>::filter_velocity() {
     }
   }
   to_elements(filter_node_.data(), Dim);
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nn > kParallelMin)
   for (Index i = 0; i < nn; ++i) {
     double acc[Dim];
     back_to_nodes(i, acc);
@@ -547,7 +551,7 @@ void StaggeredSolver<Dim>::finish_step(const double* v_prev) {
   const Index nn = disc_.nodes.size();
   const Index blocks = (nn + kReductionBlock - 1) / kReductionBlock;
   constexpr int kSums = Dim + 2;  // momentum (Dim), sum m v^2, non-finite flag
-#pragma omp parallel for schedule(static)
+#pragma omp parallel for schedule(static) if (nn > kParallelMin)
   for (Index blk = 0; blk < blocks; ++blk) {
     double sums[kSums] = {};
     const Index end = std::min(nn, (blk + 1) * kReductionBlock);
