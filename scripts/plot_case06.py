@@ -44,7 +44,7 @@ def main(d):
     ax.set_yscale("log")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
-    ax.set_title("Profiles across the band at mid-height (band width = FWHM)")
+    ax.set_title("Profiles across the band at mid-height when $u_c$ first exceeds 0.05 H (band width = FWHM)")
     fig.tight_layout()
     fig.savefig(d / "band_profiles.png", dpi=110)
     plt.close(fig)

@@ -145,6 +145,10 @@ CutRun run_cut(const std::string& file, const std::vector<std::string>& override
         r.onset = snapshot(solver, solver.time());
         r.has_onset = true;
       }
+      if (!r.has_collapse_state && uc > 0.05 * r.height) {
+        r.at_collapse = snapshot(solver, solver.time());
+        r.has_collapse_state = true;
+      }
       if (n % every == 0 || n == steps) record();
     }
   } catch (const SolverError& e) {

@@ -45,6 +45,10 @@ struct CutRun {
   CutSnapshot final_state;
   CutSnapshot onset;                   // when u_c first exceeded the onset threshold (if it did)
   bool has_onset = false;
+  /// When u_c first exceeded the collapse threshold 0.05 H (CASES.md §1.3), if it did: fields
+  /// of different runs compared at the same crest displacement.
+  CutSnapshot at_collapse;
+  bool has_collapse_state = false;
   double damping_off_time = 0.0;       // s, infinity if the kinetic-energy switch never fired
   double peak_ke = 0.0;
   long steps = 0;
