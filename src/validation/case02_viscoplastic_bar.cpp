@@ -271,20 +271,16 @@ CaseReport validate_case02(const Options& opt, const std::string& dir) {
     rep.notes.push_back("quick mode: resolutions dx = 0.02 and 0.01 m only (objectivity 0.02 -> 0.01); "
                         "--full adds dx = 0.005 m and the gamma_f = 1e4 diagnostic");
   }
-  // Open deviations, documented in docs/VALIDATION.md: shown as not met in the report, they do
-  // not fail the command so that CI keeps guarding every other criterion. Each names what was
-  // measured; none of them widens a tolerance.
+  // Known deviation, documented in docs/VALIDATION.md: shown as not met in the report, it does
+  // not fail the command. It widens no tolerance; every other failure fails the command.
   for (Metric& m : rep.metrics) {
     if (m.pass()) continue;
-    if (m.name.find("eps_vp_eq") != std::string::npos || m.name.find("w50") != std::string::npos) {
+    if (m.name.find("objectivity dx 0.02 -> 0.01") != std::string::npos && m.name.find("w50") != std::string::npos) {
       m.known_deviation =
-          "open: the eps_vp_eq peak at the fixed end is flattened over about 3 particles where the "
-          "reference has a cusp; it rises with refinement (max 0.0296 at dx 0.02, 0.0361 at 0.01 m), "
-          "so max eps and w50 are not converged at dx = 0.01 m; cause not yet established";
-    } else if (m.name.find("elastic front") != std::string::npos) {
-      m.known_deviation =
-          "open: the velocity-driven step front lags its exact position by a little more than 3 dx "
-          "(case 1's traction step: 2.4 dx); not yet investigated";
+          "dx = 0.02 m is outside the converged range of the band width: the eps_vp_eq cusp at the "
+          "wall (reference 0.0475 at x = 0, 0.0321 at 0.05 m) is smoothed over the kernel support, "
+          "and w50 ~ 0.1 m spans only 5 particles; w50 = 0.142 / 0.107 / 0.105 m at dx = 0.02 / "
+          "0.01 / 0.005, i.e. 1.9 % between 0.01 and 0.005 m (--full)";
     }
   }
   std::string note;
