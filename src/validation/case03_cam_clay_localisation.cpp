@@ -335,6 +335,7 @@ CaseReport validate_case03(const Options& opt, const std::string& dir) {
   if (opt.full) {
     const SampleResult f = run_sample(case_file, 0.01, 0.08, {0.08}, q_y);
     write_history(fmt::format("{}/history_dx{}.csv", dir, 0.01), f);
+    write_snapshots(fmt::format("{}/snapshots_dx{}.csv", dir, 0.01), f);
     rep.metrics.push_back(metric("refinement dx 0.02 -> 0.01: band angle change", std::abs(f.band_angle - r.band_angle), "<=", 5.0, "deg"));
     rep.metrics.push_back(metric("refinement dx 0.02 -> 0.01: relative change of q at 6 %",
                                  std::abs(f.q_at_6 / r.q_at_6 - 1.0), "<=", 0.10, ""));
