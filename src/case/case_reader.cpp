@@ -257,6 +257,7 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
                fmt::format("must lie in [0, 1) (a fraction of the peak kinetic energy), got {}",
                            c.damping_until_kinetic_ratio));
     c.damping_ratio_from = d->non_negative("kinetic_ratio_from", 0.0);
+    c.damping_ratio_hold = d->non_negative("kinetic_ratio_hold", 0.0);
     d->finish();
   }
 

@@ -109,6 +109,7 @@ struct CaseSetup {
   /// its peak (0 = never), tested from damping_ratio_from on (e.g. the end of a gravity ramp)
   double damping_until_kinetic_ratio = 0.0;
   double damping_ratio_from = 0.0;
+  double damping_ratio_hold = 0.0;  // s the kinetic energy must stay below the ratio before the switch
   std::vector<BoundarySpec<Dim>> boundaries;
 
   // initial state

@@ -596,9 +596,15 @@ void StaggeredSolver<Dim>::finish_step(const double* v_prev) {
   // Damping switched off once the kinetic energy has decayed (METHOD.md §4.2 option B).
   const double kinetic = 0.5 * total[Dim];
   kinetic_peak_ = std::max(kinetic_peak_, kinetic);
-  if (setup_.damping_until_kinetic_ratio > 0.0 && t_new >= setup_.damping_ratio_from &&
-      t_new < damping_off_time_ && kinetic < setup_.damping_until_kinetic_ratio * kinetic_peak_) {
-    damping_off_time_ = t_new;
+  // It must stay below the ratio for damping.kinetic_ratio_hold (an oscillation trough alone,
+  // with the energy momentarily in strain, must not end the relaxation).
+  if (setup_.damping_until_kinetic_ratio > 0.0 && t_new >= setup_.damping_ratio_from && t_new < damping_off_time_) {
+    if (kinetic < setup_.damping_until_kinetic_ratio * kinetic_peak_) {
+      if (kinetic_below_since_ < 0.0) kinetic_below_since_ = t_new;
+      if (t_new - kinetic_below_since_ >= setup_.damping_ratio_hold) damping_off_time_ = t_new;
+    } else {
+      kinetic_below_since_ = -1.0;
+    }
   }
   const double cd = damping_at(t_new);
   const double damping_power = cd * total[Dim];

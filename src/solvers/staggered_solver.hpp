@@ -168,6 +168,7 @@ class StaggeredSolver {
   double external_work_ = 0.0, damping_loss_ = 0.0, initial_strain_ = 0.0;
   double last_power_ = 0.0, last_damping_power_ = 0.0;
   double kinetic_peak_ = 0.0, damping_off_time_ = std::numeric_limits<double>::infinity();
+  double kinetic_below_since_ = -1.0;  // time since when the kinetic energy is below the ratio, -1 = not
 
   // ---- V3 state (empty in V1)
   bool saturated_ = false;
