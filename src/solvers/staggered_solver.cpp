@@ -252,7 +252,8 @@ void StaggeredSolver<Dim>::build_constraints() {
 
   constraint_row_.assign(nn + 1, 0);
   diff_row_of_node_.assign(nn, -1);
-  std::vector<Index> constrained;
+  std::vector<Index>& constrained = constrained_nodes_;
+  constrained.clear();
   for (std::size_t i = 0; i < nn; ++i) {
     std::sort(per_node[i].begin(), per_node[i].end(),
               [](const auto& a, const auto& b) { return a.component < b.component; });
@@ -314,8 +315,8 @@ void StaggeredSolver<Dim>::set_initial_state() {
 
 template <int Dim>
 void StaggeredSolver<Dim>::apply_constraints(double t) {
-  const auto nn = static_cast<Index>(disc_.nodes.size());
-  for (Index i = 0; i < nn; ++i) {
+  // Only the few constrained nodes, not the whole set: this runs two or three times a step.
+  for (const Index i : constrained_nodes_) {
     for (Index k = constraint_row_[static_cast<std::size_t>(i)]; k < constraint_row_[static_cast<std::size_t>(i) + 1]; ++k) {
       const NodalConstraint& c = constraints_[static_cast<std::size_t>(k)];
       node_phi_[static_cast<std::size_t>(i) * NV + static_cast<std::size_t>(c.component)] =

@@ -145,6 +145,7 @@ class StaggeredSolver {
   std::vector<Index> constraint_row_;
   std::vector<NodalConstraint> constraints_;
   std::vector<Index> diff_row_of_node_;  // row in diff_ne_, or -1
+  std::vector<Index> constrained_nodes_;  // nodes with at least one constraint, ascending
   std::vector<Index> boundary_nodes_;    // nodes on a face of the body (for traction power)
 
   // state
