@@ -3,7 +3,6 @@
 
 Usage: /usr/bin/python3 scripts/plot_case01.py DIR   (DIR = validation/case01)
 """
-import csv
 import sys
 from pathlib import Path
 
@@ -11,12 +10,8 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from plot_common import read  # noqa: E402
 
-
-def read(path):
-    with open(path) as f:
-        rows = list(csv.DictReader(f))
-    return {k: [float(r[k]) for r in rows] for k in rows[0]}
 
 
 def main(d):

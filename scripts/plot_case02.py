@@ -4,7 +4,6 @@
 
 Usage: /usr/bin/python3 scripts/plot_case02.py DIR   (DIR = validation/case02)
 """
-import csv
 import sys
 from pathlib import Path
 
@@ -12,6 +11,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from plot_common import read  # noqa: E402
 
 L_OVER_C = 10.0 / (1.0e7 / 2000.0) ** 0.5
 # CASES.md Case 2, Variant B reference at t_end = 1.8 L/c.
@@ -20,11 +20,6 @@ EPS_REF = [0.0475, 0.0321, 0.0234, 0.0132, 0.0079, 0.0034, 0.0007]
 SIG_X = [1.0, 2.0, 3.0, 5.0, 7.0, 9.5]
 SIG_REF = [18.8, 19.6, 20.0, 20.0, 20.0, 15.0]
 
-
-def read(path):
-    with open(path) as f:
-        rows = list(csv.DictReader(f))
-    return {k: [float(r[k]) for r in rows] for k in rows[0]}
 
 
 def spacing(p, prefix):

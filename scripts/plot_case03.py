@@ -4,7 +4,6 @@ by `rktsph validate`.
 
 Usage: /usr/bin/python3 scripts/plot_case03.py DIR   (DIR = validation/case03)
 """
-import csv
 import sys
 from pathlib import Path
 
@@ -12,12 +11,8 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from plot_common import read  # noqa: E402
 
-
-def read(path):
-    with open(path) as f:
-        rows = list(csv.DictReader(f))
-    return {k: [float(r[k]) for r in rows] for k in rows[0]}
 
 
 def main(d):

@@ -3,7 +3,6 @@
 
 Usage: /usr/bin/python3 scripts/plot_case04.py DIR   (DIR = validation/case04)
 """
-import csv
 import sys
 from pathlib import Path
 
@@ -11,18 +10,8 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from plot_common import read  # noqa: E402
 
-
-def read(path):
-    with open(path) as f:
-        rows = list(csv.DictReader(f))
-    out = {}
-    for k in rows[0]:
-        try:
-            out[k] = [float(r[k]) for r in rows]
-        except ValueError:
-            out[k] = [r[k] for r in rows]
-    return out
 
 
 def dx_of(p, prefix):

@@ -4,7 +4,6 @@
 
 Usage: /usr/bin/python3 scripts/plot_case05.py DIR   (DIR = validation/case05)
 """
-import csv
 import math
 import sys
 from pathlib import Path
@@ -13,12 +12,8 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from plot_common import read  # noqa: E402
 
-
-def read(path):
-    with open(path) as f:
-        rows = list(csv.DictReader(f))
-    return {k: [float(r[k]) for r in rows] for k in rows[0]}
 
 
 def histories(d, fig_path, title, pattern_labels, H=10.0):

@@ -5,7 +5,6 @@
 
 Usage: /usr/bin/python3 scripts/plot_case13.py DIR   (DIR = validation/case13)
 """
-import csv
 import math
 import sys
 from pathlib import Path
@@ -14,14 +13,10 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from plot_common import read  # noqa: E402
 
 TV = ["0.05", "0.1", "0.2", "0.5", "1"]
 
-
-def read(path):
-    with open(path) as f:
-        rows = list(csv.DictReader(f))
-    return {k: [float(r[k]) for r in rows] for k in rows[0]}
 
 
 def spacing(p, prefix):

@@ -5,7 +5,6 @@ and 1.0, and the top displacement.
 
 Usage: /usr/bin/python3 scripts/plot_case14.py DIR   (DIR = validation/case14)
 """
-import csv
 import re
 import sys
 from pathlib import Path
@@ -14,12 +13,8 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from plot_common import read  # noqa: E402
 
-
-def read(path):
-    with open(path) as f:
-        rows = list(csv.DictReader(f))
-    return {k: [float(r[k]) for r in rows] for k in rows[0]}
 
 
 def key(p):
