@@ -22,28 +22,24 @@ struct ElasticBar {
   double sigma0;      // Pa, tension positive
   double rise_time;   // s; 0 for a step load
 
-  double stress(double x, double t) const {
-    double s = 0.0;
-    const double L = length, c = wave_speed;
-    for (int k = 0;; ++k) {
-      const double a = (2.0 * k * L + (L - x)) / c;
-      if (a > t) break;
-      const double sign = (k % 2 == 0) ? 1.0 : -1.0;
-      s += sign * (smooth_step(t - a, rise_time) + smooth_step(t - (2.0 * k * L + (L + x)) / c, rise_time));
-    }
-    return sigma0 * s;
+  double stress(double x, double t) const { return sigma0 * images(x, t, +1.0); }
+  double velocity(double x, double t) const {
+    return sigma0 / (density * wave_speed) * images(x, t, -1.0);
   }
 
-  double velocity(double x, double t) const {
-    double v = 0.0;
+  /// sum_k (-1)^k [S(t - (2kL + L - x)/c) + reflected * S(t - (2kL + L + x)/c)]: the incident and
+  /// reflected image waves; stress adds them (reflected = +1), velocity subtracts them (-1).
+  double images(double x, double t, double reflected) const {
+    double sum = 0.0;
     const double L = length, c = wave_speed;
     for (int k = 0;; ++k) {
       const double a = (2.0 * k * L + (L - x)) / c;
       if (a > t) break;
       const double sign = (k % 2 == 0) ? 1.0 : -1.0;
-      v += sign * (smooth_step(t - a, rise_time) - smooth_step(t - (2.0 * k * L + (L + x)) / c, rise_time));
+      sum += sign * (smooth_step(t - a, rise_time) +
+                     reflected * smooth_step(t - (2.0 * k * L + (L + x)) / c, rise_time));
     }
-    return sigma0 / (density * c) * v;
+    return sum;
   }
 
   /// Distance from x to the nearest wave front of the step solution at time t.
