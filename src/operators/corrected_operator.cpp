@@ -1,7 +1,11 @@
 #include "operators/corrected_operator.hpp"
 
 #include <algorithm>
-#include <numeric>
+#include <bit>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <unordered_map>
 
 #include <Eigen/Dense>
 
@@ -28,87 +32,265 @@ std::vector<Pair<Dim>> sorted_neighbours(const CellList<Dim>& cells, const Vec<D
   return pairs;
 }
 
+// Rows are assembled in fixed blocks: each block finds its own patterns (in parallel), then the
+// blocks are merged in order. The patterns, and so the weights every row ends up with, are
+// therefore the same whatever the number of threads (tests/solvers/test_threads.cpp).
+constexpr Index kBuildBlock = 1024;
+
+// Sources within this fraction of 2h of the edge of the support are left out. Their weights are
+// below 1e-19 of the row's (W ~ (2 - q)^3, grad W ~ (2 - q)^2), so the operator is unchanged to
+// round-off; but when 2h is a multiple of a lattice distance (h/dx = 1 or 1.5 for node-node
+// pairs) such sources lie exactly on the edge, and round-off in the positions would keep them in
+// some rows of a class and not in others, splitting the class into many patterns.
+constexpr double kSupportGap = 1e-10;
+
+inline std::uint64_t hash_mix(std::uint64_t h, std::uint64_t v) {
+  h ^= v + 0x9e3779b97f4a7c15ULL + (h << 6) + (h >> 2);
+  return h * 0xbf58476d1ce4e5b9ULL;
+}
+
+// The geometry of one row, which alone fixes its weights: per source (sorted by index) the
+// offset from the row's first source, (x_b - x_a)/h and V_b.
+template <int Dim>
+struct RowGeometry {
+  static constexpr std::size_t G = Dim + 1;  // doubles of geometry per pair
+  std::vector<Pair<Dim>> pairs;
+  std::vector<Index> offset;
+  std::vector<double> geometry;
+  std::uint64_t key = 0;
+
+  // Hash of the offsets and of the geometry rounded to 2^-20 h (positions) and to 20 bits of
+  // mantissa (volumes): coarse enough that round-off almost never changes it (a row that does
+  // land in another bucket only gets a pattern of its own, which is still correct), fine
+  // enough that genuinely different rows (jittered sets) rarely share a bucket.
+  void finish(const ParticleSet<Dim>& sources, double h) {
+    const std::size_t n = pairs.size();
+    offset.resize(n);
+    geometry.resize(n * G);
+    std::uint64_t k = hash_mix(0, n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const Pair<Dim>& p = pairs[i];
+      offset[i] = p.b - pairs[0].b;
+      k = hash_mix(k, static_cast<std::uint64_t>(offset[i]));
+      for (int d = 0; d < Dim; ++d) {
+        const double x = -p.x_ab[d] / h;
+        geometry[i * G + static_cast<std::size_t>(d)] = x;
+        k = hash_mix(k, static_cast<std::uint64_t>(std::llround(x * 1048576.0)));
+      }
+      const double V = sources.volume[static_cast<std::size_t>(p.b)];
+      geometry[i * G + Dim] = V;
+      k = hash_mix(k, std::bit_cast<std::uint64_t>(V) >> 32);
+    }
+    key = k;
+  }
+};
+
+// Patterns under construction (one table per block, and the merged one), with their geometry
+// and a hash index on it.
+template <int Dim>
+struct PatternTable {
+  static constexpr std::size_t G = Dim + 1;
+  std::vector<Index> start{0};
+  std::vector<Index> offset;
+  std::vector<double> geometry;
+  std::vector<double> interp;
+  std::vector<std::array<double, Dim>> grad;
+  std::vector<char> degenerate;
+  std::vector<std::uint64_t> key;
+  std::vector<Index> next_same_key;  // chain of the patterns that share a hash
+  std::unordered_map<std::uint64_t, Index> head;
+
+  Index size() const { return static_cast<Index>(start.size()) - 1; }
+
+  // Pattern whose offsets equal `off` and whose geometry matches `geo` within the tolerances,
+  // or -1.
+  Index find(std::uint64_t k, const Index* off, const double* geo, std::size_t n, double tol_x,
+             double tol_v) const {
+    const auto it = head.find(k);
+    if (it == head.end()) return -1;
+    for (Index p = it->second; p >= 0; p = next_same_key[static_cast<std::size_t>(p)]) {
+      const auto b = static_cast<std::size_t>(start[static_cast<std::size_t>(p)]);
+      const auto e = static_cast<std::size_t>(start[static_cast<std::size_t>(p) + 1]);
+      if (e - b != n || !std::equal(off, off + n, offset.begin() + static_cast<std::ptrdiff_t>(b))) continue;
+      bool same = true;
+      for (std::size_t i = 0; i < n && same; ++i) {
+        const double* g = &geometry[(b + i) * G];
+        for (int d = 0; d < Dim; ++d) same = same && std::abs(g[d] - geo[i * G + static_cast<std::size_t>(d)]) <= tol_x;
+        same = same && std::abs(g[Dim] - geo[i * G + Dim]) <= tol_v * std::max(std::abs(g[Dim]), std::abs(geo[i * G + Dim]));
+      }
+      if (same) return p;
+    }
+    return -1;
+  }
+
+  // Append a pattern (its weights in interp/grad[first, first + n) of `w`); returns its id.
+  Index add(std::uint64_t k, const Index* off, const double* geo, std::size_t n, const double* wi,
+            const std::array<double, Dim>* wg, bool degen, bool index) {
+    const Index id = size();
+    offset.insert(offset.end(), off, off + n);
+    geometry.insert(geometry.end(), geo, geo + n * G);
+    interp.insert(interp.end(), wi, wi + n);
+    grad.insert(grad.end(), wg, wg + n);
+    start.push_back(static_cast<Index>(offset.size()));
+    degenerate.push_back(degen ? 1 : 0);
+    key.push_back(k);
+    next_same_key.push_back(-1);
+    if (index) {
+      // New patterns go to the end of their chain, so that find() returns the earliest match.
+      const auto [it, inserted] = head.try_emplace(k, id);
+      if (!inserted) {
+        Index p = it->second;
+        while (next_same_key[static_cast<std::size_t>(p)] >= 0) p = next_same_key[static_cast<std::size_t>(p)];
+        next_same_key[static_cast<std::size_t>(p)] = id;
+      }
+    }
+    return id;
+  }
+};
+
+// The weights M_a^{-1} V_b [W_ab; h grad_a W_ab] of one row (METHOD.md §3.2), in units of h so
+// that the (n_d+1) system is well scaled. Returns false if the row is degenerate.
+template <int Dim>
+bool row_weights(const std::vector<Pair<Dim>>& pairs, const ParticleSet<Dim>& sources,
+                 const CubicSplineKernel<Dim>& kernel, std::vector<Eigen::Matrix<double, Dim + 1, 1>>& basis,
+                 std::vector<double>& wi, std::vector<std::array<double, Dim>>& wg) {
+  constexpr int N = Dim + 1;
+  using MatN = Eigen::Matrix<double, N, N>;
+  using VecN = Eigen::Matrix<double, N, 1>;
+  const double h = kernel.h();
+  const std::size_t n = pairs.size();
+  MatN M = MatN::Zero();
+  basis.resize(n);
+  wi.resize(n);
+  wg.resize(n);
+  double shepard = 0.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto& p = pairs[k];
+    const double V = sources.volume[static_cast<std::size_t>(p.b)];
+    VecN w;
+    w[0] = V * kernel.value(p.r);
+    w.template tail<Dim>() = V * h * kernel.gradient(p.x_ab);
+    VecN dx;
+    dx[0] = 1.0;
+    dx.template tail<Dim>() = -p.x_ab / h;  // (x_b - x_a)/h
+    M += w * dx.transpose();
+    basis[k] = w;
+    shepard += w[0];
+  }
+  // M is O(1) in these units; a tiny determinant means too few or collinear sources.
+  const bool ok = n > 0 && std::abs(M.determinant()) > 1e-8;
+  const MatN Minv = ok ? MatN(M.inverse()) : MatN::Identity();
+  for (std::size_t k = 0; k < n; ++k) {
+    VecN c;
+    if (ok) {
+      c = Minv * basis[k];
+    } else {
+      // Too few sources for the corrected system: Shepard interpolation and the plain
+      // kernel gradient (METHOD.md §3.2 guard).
+      c = basis[k];
+      c[0] = shepard > 0.0 ? basis[k][0] / shepard : 0.0;
+    }
+    wi[k] = c[0];
+    for (int d = 0; d < Dim; ++d) wg[k][static_cast<std::size_t>(d)] = c[d + 1] / h;
+  }
+  return ok;
+}
+
 }  // namespace
 
 template <int Dim>
 CorrectedOperator<Dim> build_corrected_operator(const std::vector<Vec<Dim>>& targets,
                                                 const ParticleSet<Dim>& sources,
-                                                const CubicSplineKernel<Dim>& kernel) {
-  constexpr int N = Dim + 1;
-  using MatN = Eigen::Matrix<double, N, N>;
-  using VecN = Eigen::Matrix<double, N, 1>;
+                                                const CubicSplineKernel<Dim>& kernel,
+                                                const OperatorOptions& options) {
+  constexpr std::size_t G = Dim + 1;
   const double h = kernel.h();
   const CellList<Dim> cells(sources.position, kernel.support_radius());
+  const double r_max = kernel.support_radius() * (1.0 - kSupportGap);
   const auto nt = static_cast<Index>(targets.size());
+  const bool share = options.share_patterns;
 
-  CorrectedOperator<Dim> op;
-  // Pass 1: count the sources of every target, so that rows can be filled in parallel.
-  op.row_start.assign(static_cast<std::size_t>(nt) + 1, 0);
-#pragma omp parallel for schedule(static) if (nt > 2048)
-  for (Index a = 0; a < nt; ++a) {
-    Index count = 0;
-    cells.for_each_neighbour(targets[static_cast<std::size_t>(a)], [&](Index, const Vec<Dim>&, double) { ++count; });
-    op.row_start[static_cast<std::size_t>(a) + 1] = count;
-  }
-  for (std::size_t a = 0; a < static_cast<std::size_t>(nt); ++a) op.row_start[a + 1] += op.row_start[a];
-  const auto npairs = static_cast<std::size_t>(op.row_start.back());
-  op.source.resize(npairs);
-  op.interp.resize(npairs);
-  op.grad.resize(npairs);
+  // Geometry tolerances for sharing a pattern. Lattice positions origin + i dx carry round-off
+  // of an ulp of the largest coordinate, so relative positions of two rows of one class differ
+  // by that much: accept a few ulps of it (in units of h), and 1e-12 h in any case. Volumes are
+  // products of dx and exact fractions: relative 1e-12. The weights of rows that share a
+  // pattern then differ from their own by round-off of the positions (the tests check 1e-12).
+  double xmax = 0.0;
+  for (const auto& x : targets) xmax = std::max(xmax, x.cwiseAbs().maxCoeff());
+  for (const auto& x : sources.position) xmax = std::max(xmax, x.cwiseAbs().maxCoeff());
+  const double tol_x = 1e-12 + 4.0 * std::numeric_limits<double>::epsilon() * xmax / h;
+  const double tol_v = 1e-12;
 
-  Index degenerate = 0;
-  // Pass 2: per target, the sorted pairs and the weights M_a^{-1} V_b [W_ab; h grad_a W_ab].
-#pragma omp parallel reduction(+ : degenerate) if (nt > 2048)
+  const Index nblocks = (nt + kBuildBlock - 1) / kBuildBlock;
+  std::vector<PatternTable<Dim>> local(static_cast<std::size_t>(nblocks));
+  std::vector<Index> base(static_cast<std::size_t>(nt)), pattern(static_cast<std::size_t>(nt));
+
+#pragma omp parallel if (nt > 2048)
   {
-    std::vector<Pair<Dim>> pairs;
-    std::vector<VecN> basis;
-#pragma omp for schedule(static)
-    for (Index a = 0; a < nt; ++a) {
-      pairs.clear();
-      cells.for_each_neighbour(targets[static_cast<std::size_t>(a)], [&](Index b, const Vec<Dim>& x_ab, double r) {
-        pairs.push_back({b, x_ab, r});
-      });
-      std::sort(pairs.begin(), pairs.end(), [](const auto& p, const auto& q) { return p.b < q.b; });
-      // Work in units of h so that the (n_d+1) system is well scaled.
-      MatN M = MatN::Zero();
-      basis.resize(pairs.size());
-      double shepard = 0.0;
-      for (std::size_t k = 0; k < pairs.size(); ++k) {
-        const auto& p = pairs[k];
-        const double V = sources.volume[static_cast<std::size_t>(p.b)];
-        VecN w;
-        w[0] = V * kernel.value(p.r);
-        w.template tail<Dim>() = V * h * kernel.gradient(p.x_ab);
-        VecN dx;
-        dx[0] = 1.0;
-        dx.template tail<Dim>() = -p.x_ab / h;  // (x_b - x_a)/h
-        M += w * dx.transpose();
-        basis[k] = w;
-        shepard += w[0];
-      }
-      // M is O(1) in these units; a tiny determinant means too few or collinear sources.
-      const bool ok = !pairs.empty() && std::abs(M.determinant()) > 1e-8;
-      MatN Minv = MatN::Identity();
-      if (ok) Minv = M.inverse();
-      else ++degenerate;
-      auto k0 = static_cast<std::size_t>(op.row_start[static_cast<std::size_t>(a)]);
-      for (std::size_t k = 0; k < pairs.size(); ++k, ++k0) {
-        VecN c;
-        if (ok) {
-          c = Minv * basis[k];
-        } else {
-          // Too few sources for the corrected system: Shepard interpolation and the plain
-          // kernel gradient (METHOD.md §3.2 guard).
-          c = basis[k];
-          c[0] = shepard > 0.0 ? basis[k][0] / shepard : 0.0;
+    RowGeometry<Dim> row;
+    std::vector<Eigen::Matrix<double, Dim + 1, 1>> basis;
+    std::vector<double> wi;
+    std::vector<std::array<double, Dim>> wg;
+#pragma omp for schedule(dynamic)
+    for (Index blk = 0; blk < nblocks; ++blk) {
+      PatternTable<Dim>& table = local[static_cast<std::size_t>(blk)];
+      const Index end = std::min(nt, (blk + 1) * kBuildBlock);
+      for (Index a = blk * kBuildBlock; a < end; ++a) {
+        const auto au = static_cast<std::size_t>(a);
+        row.pairs.clear();
+        cells.for_each_neighbour(targets[au], [&](Index b, const Vec<Dim>& x_ab, double r) {
+          if (r < r_max) row.pairs.push_back({b, x_ab, r});
+        });
+        std::sort(row.pairs.begin(), row.pairs.end(), [](const auto& p, const auto& q) { return p.b < q.b; });
+        row.finish(sources, h);
+        const std::size_t n = row.pairs.size();
+        base[au] = n > 0 ? row.pairs[0].b : 0;
+        Index p = share ? table.find(row.key, row.offset.data(), row.geometry.data(), n, tol_x, tol_v) : -1;
+        if (p < 0) {
+          // A new geometry: its weights are computed once, here.
+          const bool ok = row_weights<Dim>(row.pairs, sources, kernel, basis, wi, wg);
+          p = table.add(row.key, row.offset.data(), row.geometry.data(), n, wi.data(), wg.data(), !ok, share);
         }
-        op.source[k0] = pairs[k].b;
-        op.interp[k0] = c[0];
-        for (int d = 0; d < Dim; ++d) op.grad[k0][static_cast<std::size_t>(d)] = c[d + 1] / h;
+        pattern[au] = p;
       }
     }
   }
-  op.degenerate_rows = degenerate;
+
+  // Merge the blocks in order: a block's pattern joins the first matching pattern of the
+  // blocks before it.
+  PatternTable<Dim> all;
+  std::vector<Index> map;
+  for (Index blk = 0; blk < nblocks; ++blk) {
+    PatternTable<Dim>& table = local[static_cast<std::size_t>(blk)];
+    map.assign(static_cast<std::size_t>(table.size()), -1);
+    for (Index q = 0; q < table.size(); ++q) {
+      const auto qu = static_cast<std::size_t>(q);
+      const auto b = static_cast<std::size_t>(table.start[qu]);
+      const auto n = static_cast<std::size_t>(table.start[qu + 1]) - b;
+      Index g = share ? all.find(table.key[qu], &table.offset[b], &table.geometry[b * G], n, tol_x, tol_v) : -1;
+      if (g < 0) {
+        g = all.add(table.key[qu], &table.offset[b], &table.geometry[b * G], n, &table.interp[b], &table.grad[b],
+                    table.degenerate[qu] != 0, share);
+      }
+      map[qu] = g;
+    }
+    const Index end = std::min(nt, (blk + 1) * kBuildBlock);
+    for (Index a = blk * kBuildBlock; a < end; ++a) pattern[static_cast<std::size_t>(a)] = map[static_cast<std::size_t>(pattern[static_cast<std::size_t>(a)])];
+    table = PatternTable<Dim>();  // release the block's storage as we go
+  }
+
+  CorrectedOperator<Dim> op;
+  op.base = std::move(base);
+  op.pattern = std::move(pattern);
+  op.pattern_start = std::move(all.start);
+  op.offset = std::move(all.offset);
+  op.interp = std::move(all.interp);
+  op.grad = std::move(all.grad);
+  for (Index a = 0; a < nt; ++a) {
+    const auto p = static_cast<std::size_t>(op.pattern[static_cast<std::size_t>(a)]);
+    op.pair_count += static_cast<std::size_t>(op.pattern_start[p + 1] - op.pattern_start[p]);
+    if (all.degenerate[p] != 0) ++op.degenerate_rows;
+  }
   return op;
 }
 
@@ -150,7 +332,8 @@ DifferenceGradient<Dim> build_difference_gradient(const std::vector<Vec<Dim>>& t
 
 #define RKTSPH_INSTANTIATE(D)                                                                   \
   template CorrectedOperator<D> build_corrected_operator<D>(                                    \
-      const std::vector<Vec<D>>&, const ParticleSet<D>&, const CubicSplineKernel<D>&);          \
+      const std::vector<Vec<D>>&, const ParticleSet<D>&, const CubicSplineKernel<D>&,           \
+      const OperatorOptions&);                                                                  \
   template DifferenceGradient<D> build_difference_gradient<D>(                                  \
       const std::vector<Vec<D>>&, const std::vector<Index>&, const ParticleSet<D>&,            \
       const CubicSplineKernel<D>&);

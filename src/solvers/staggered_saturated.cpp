@@ -123,8 +123,10 @@ void StaggeredSolver<Dim>::pressure_step(double t_new) {
   const double sw = setup_.fluid.saturation;
   const double inv_q_dt = inv_storage_ / dt_;
   pw_old_ = pw_;
-  const Index* row = op_nn_.row_start.data();
-  const Index* src = op_nn_.source.data();
+  const Index* base = op_nn_.base.data();
+  const Index* pat = op_nn_.pattern.data();
+  const Index* pstart = op_nn_.pattern_start.data();
+  const Index* off = op_nn_.offset.data();
   const auto* wg = op_nn_.grad.data();
   double* phi = node_phi_.data();
   // RHS_I = p^n_I/(Q* dt) - S_w (div v*)_I; drained nodes take their value at t^{n+1}.
@@ -132,8 +134,8 @@ void StaggeredSolver<Dim>::pressure_step(double t_new) {
   for (Index i = 0; i < nn; ++i) {
     const auto iu = static_cast<std::size_t>(i);
     double div = 0.0;
-    for (Index k = row[i]; k < row[i + 1]; ++k) {
-      const double* v = phi + static_cast<std::size_t>(src[k]) * NV;
+    for (Index k = pstart[pat[i]]; k < pstart[pat[i] + 1]; ++k) {
+      const double* v = phi + static_cast<std::size_t>(base[i] + off[k]) * NV;
       for (int d = 0; d < Dim; ++d) div += wg[k][static_cast<std::size_t>(d)] * v[d];
     }
     pw_source_[iu] = pw_old_[iu] * inv_q_dt - sw * div;
@@ -145,8 +147,8 @@ void StaggeredSolver<Dim>::pressure_step(double t_new) {
   for (Index i = 0; i < nn; ++i) {
     const auto iu = static_cast<std::size_t>(i);
     double g[Dim] = {};
-    for (Index k = row[i]; k < row[i + 1]; ++k) {
-      const double p = pw_[static_cast<std::size_t>(src[k])];
+    for (Index k = pstart[pat[i]]; k < pstart[pat[i] + 1]; ++k) {
+      const double p = pw_[static_cast<std::size_t>(base[i] + off[k])];
       for (int d = 0; d < Dim; ++d) g[d] += wg[k][static_cast<std::size_t>(d)] * p;
     }
     const double f = dt_ / disc_.nodes.density[iu];

@@ -363,8 +363,12 @@ void StaggeredSolver<Dim>::step_elements(double t) {
   for (int d = 0; d < Dim; ++d) b[d] = fb * setup_.gravity[d];
   const double cd = damping_at(t);
   const Index ne = disc_.elements.size();
-  const Index* row = op_en_.row_start.data();
-  const Index* src = op_en_.source.data();
+  // Shared row patterns (operators/corrected_operator.hpp): pair k of element e has the source
+  // base[e] + off[k]; on a lattice the few patterns' weights stay in the L1 cache.
+  const Index* base = op_en_.base.data();
+  const Index* pat = op_en_.pattern.data();
+  const Index* pstart = op_en_.pattern_start.data();
+  const Index* off = op_en_.offset.data();
   const double* wi = op_en_.interp.data();
   const auto* wg = op_en_.grad.data();
   const double* nphi = node_phi_.data();
@@ -373,8 +377,10 @@ void StaggeredSolver<Dim>::step_elements(double t) {
   for (Index e = 0; e < ne; ++e) {
     double bar[NV] = {};
     double grad[Dim][NV] = {};
-    for (Index k = row[e]; k < row[e + 1]; ++k) {
-      const double* p = nphi + static_cast<std::size_t>(src[k]) * NV;
+    const Index k0 = pstart[pat[e]], k1 = pstart[pat[e] + 1];
+    const double* row_phi = nphi + static_cast<std::size_t>(base[e]) * NV;
+    for (Index k = k0; k < k1; ++k) {
+      const double* p = row_phi + static_cast<std::size_t>(off[k]) * NV;
       const double w0 = wi[k];
       const auto& wk = wg[k];
       for (int c = 0; c < NV; ++c) {
@@ -387,8 +393,8 @@ void StaggeredSolver<Dim>::step_elements(double t) {
     double dv[Dim], dsig[NS];
     flux_rates<Dim>(grad, 1.0 / disc_.elements.density[eu], lambda_[m], shear_[m], dv, dsig);
     if (saturated_) {  // V3 (METHOD.md §5.3): -grad p^n / rho in the element half-step
-      for (Index k = row[e]; k < row[e + 1]; ++k) {
-        const double pr = pw_[static_cast<std::size_t>(src[k])] / disc_.elements.density[eu];
+      for (Index k = k0; k < k1; ++k) {
+        const double pr = pw_[static_cast<std::size_t>(base[e] + off[k])] / disc_.elements.density[eu];
         for (int d = 0; d < Dim; ++d) dv[d] -= wg[k][static_cast<std::size_t>(d)] * pr;
       }
     }
@@ -405,8 +411,8 @@ void StaggeredSolver<Dim>::step_elements(double t) {
       // History variables are interpolated from the nodes (METHOD.md §3.3: nodes are primary).
       double* ks = &elem_state_[eu * static_cast<std::size_t>(stride)];
       for (int j = 0; j < stride; ++j) ks[j] = 0.0;
-      for (Index k = row[e]; k < row[e + 1]; ++k) {
-        const double* kn = &node_state_[static_cast<std::size_t>(src[k]) * static_cast<std::size_t>(stride)];
+      for (Index k = k0; k < k1; ++k) {
+        const double* kn = &node_state_[static_cast<std::size_t>(base[e] + off[k]) * static_cast<std::size_t>(stride)];
         for (int j = 0; j < stride; ++j) ks[j] += wi[k] * kn[j];
       }
     }
@@ -423,15 +429,18 @@ void StaggeredSolver<Dim>::step_nodes(double t) {
   const double cd = damping_at(t);
   const double t_half = t + 0.5 * dt_;
   const Index nn = disc_.nodes.size();
-  const Index* row = op_ne_.row_start.data();
-  const Index* src = op_ne_.source.data();
+  const Index* base = op_ne_.base.data();
+  const Index* pat = op_ne_.pattern.data();
+  const Index* pstart = op_ne_.pattern_start.data();
+  const Index* off = op_ne_.offset.data();
   const auto* wg = op_ne_.grad.data();
   const double* ephi = elem_phi_.data();
 #pragma omp parallel for schedule(static) if (nn > kParallelMin)
   for (Index i = 0; i < nn; ++i) {
     double grad[Dim][NV] = {};
-    for (Index k = row[i]; k < row[i + 1]; ++k) {
-      const double* p = ephi + static_cast<std::size_t>(src[k]) * NV;
+    const double* row_phi = ephi + static_cast<std::size_t>(base[i]) * NV;
+    for (Index k = pstart[pat[i]]; k < pstart[pat[i] + 1]; ++k) {
+      const double* p = row_phi + static_cast<std::size_t>(off[k]) * NV;
       const auto& wk = wg[k];
       for (int c = 0; c < NV; ++c) {
         for (int d = 0; d < Dim; ++d) grad[d][c] += wk[static_cast<std::size_t>(d)] * p[c];
@@ -485,9 +494,11 @@ void StaggeredSolver<Dim>::filter_velocity() {
 #pragma omp parallel for schedule(static) if (ne > kParallelMin)
     for (Index e = 0; e < ne; ++e) {
       double acc[Dim] = {};
-      for (Index k = op_en_.row_start[static_cast<std::size_t>(e)]; k < op_en_.row_start[static_cast<std::size_t>(e) + 1]; ++k) {
+      const auto r = op_en_.row(e);
+      const double* row_field = node_field + static_cast<std::size_t>(r.base) * node_stride;
+      for (Index k = r.begin; k < r.end; ++k) {
         const double wk = op_en_.interp[static_cast<std::size_t>(k)];
-        const double* p = node_field + static_cast<std::size_t>(op_en_.source[static_cast<std::size_t>(k)]) * node_stride;
+        const double* p = row_field + static_cast<std::size_t>(op_en_.offset[static_cast<std::size_t>(k)]) * node_stride;
         for (int d = 0; d < Dim; ++d) acc[d] += wk * p[d];
       }
       for (int d = 0; d < Dim; ++d) filter_elem_[static_cast<std::size_t>(e) * Dim + static_cast<std::size_t>(d)] = acc[d];
@@ -495,9 +506,11 @@ void StaggeredSolver<Dim>::filter_velocity() {
   };
   auto back_to_nodes = [&](Index i, double* acc) {
     for (int d = 0; d < Dim; ++d) acc[d] = 0.0;
-    for (Index k = op_ne_.row_start[static_cast<std::size_t>(i)]; k < op_ne_.row_start[static_cast<std::size_t>(i) + 1]; ++k) {
+    const auto r = op_ne_.row(i);
+    const double* row_field = &filter_elem_[static_cast<std::size_t>(r.base) * Dim];
+    for (Index k = r.begin; k < r.end; ++k) {
       const double wk = op_ne_.interp[static_cast<std::size_t>(k)];
-      const double* p = &filter_elem_[static_cast<std::size_t>(op_ne_.source[static_cast<std::size_t>(k)]) * Dim];
+      const double* p = row_field + static_cast<std::size_t>(op_ne_.offset[static_cast<std::size_t>(k)]) * Dim;
       for (int d = 0; d < Dim; ++d) acc[d] += wk * p[d];
     }
   };

@@ -40,9 +40,10 @@ Errors<Dim> apply_errors(const CorrectedOperator<Dim>& op, const std::vector<Vec
     if (select && !select(xa)) continue;
     double val = 0.0;
     Vec<Dim> g = Vec<Dim>::Zero();
-    for (Index k = op.row_start[static_cast<std::size_t>(a)]; k < op.row_start[static_cast<std::size_t>(a) + 1]; ++k) {
+    const auto row = op.row(a);
+    for (Index k = row.begin; k < row.end; ++k) {
       const auto ku = static_cast<std::size_t>(k);
-      const double fb = f(sources.position[static_cast<std::size_t>(op.source[ku])]);
+      const double fb = f(sources.position[static_cast<std::size_t>(op.source(row, k))]);
       val += op.interp[ku] * fb;
       for (int d = 0; d < Dim; ++d) g[d] += op.grad[ku][static_cast<std::size_t>(d)] * fb;
     }
