@@ -54,34 +54,53 @@ inline std::uint64_t hash_mix(std::uint64_t h, std::uint64_t v) {
 template <int Dim>
 struct RowGeometry {
   static constexpr std::size_t G = Dim + 1;  // doubles of geometry per pair
+  std::vector<typename CellList<Dim>::Hit> hits;
+  std::vector<std::uint64_t> order;
   std::vector<Pair<Dim>> pairs;
   std::vector<Index> offset;
   std::vector<double> geometry;
   std::uint64_t key = 0;
 
-  // Hash of the offsets and of the geometry rounded to 2^-20 h (positions) and to 20 bits of
-  // mantissa (volumes): coarse enough that round-off almost never changes it (a row that does
-  // land in another bucket only gets a pattern of its own, which is still correct), fine
-  // enough that genuinely different rows (jittered sets) rarely share a bucket.
+  // The sources of target x within r_max, sorted by index. Sorting packed (index, slot) keys
+  // moves 8 bytes per swap instead of a whole pair.
+  void gather(const CellList<Dim>& cells, const Vec<Dim>& x, double r_max) {
+    const std::size_t n = cells.collect(x, r_max * r_max, hits);
+    order.resize(n);
+    for (std::size_t i = 0; i < n; ++i) order[i] = (static_cast<std::uint64_t>(hits[i].j) << 24) | i;
+    std::sort(order.begin(), order.end());
+    pairs.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      const auto& hit = hits[order[i] & 0xffffffu];
+      pairs[i] = {hit.j, hit.x_ij, std::sqrt(hit.r2)};
+    }
+  }
+
+  // Offsets and geometry, and a hash of the offsets, of the first source's position (rounded to
+  // 2^-20 h) and of the sum of the volumes (20 bits of mantissa): coarse enough that round-off
+  // almost never changes it (a row that does land in another bucket only gets a pattern of its
+  // own, which is still correct), fine enough that different rows (jittered sets) rarely share a
+  // bucket. The full geometry is compared on a hash hit (PatternTable::find).
   void finish(const ParticleSet<Dim>& sources, double h) {
     const std::size_t n = pairs.size();
     offset.resize(n);
     geometry.resize(n * G);
-    std::uint64_t k = hash_mix(0, n);
+    std::uint64_t k = n;
+    double volume = 0.0;
     for (std::size_t i = 0; i < n; ++i) {
       const Pair<Dim>& p = pairs[i];
       offset[i] = p.b - pairs[0].b;
-      k = hash_mix(k, static_cast<std::uint64_t>(offset[i]));
-      for (int d = 0; d < Dim; ++d) {
-        const double x = -p.x_ab[d] / h;
-        geometry[i * G + static_cast<std::size_t>(d)] = x;
-        k = hash_mix(k, static_cast<std::uint64_t>(std::llround(x * 1048576.0)));
-      }
+      k = k * 0x9e3779b97f4a7c15ULL + static_cast<std::uint64_t>(offset[i]);
+      for (int d = 0; d < Dim; ++d) geometry[i * G + static_cast<std::size_t>(d)] = -p.x_ab[d] / h;
       const double V = sources.volume[static_cast<std::size_t>(p.b)];
       geometry[i * G + Dim] = V;
-      k = hash_mix(k, std::bit_cast<std::uint64_t>(V) >> 32);
+      volume += V;
     }
-    key = k;
+    for (std::size_t d = 0; d < (n > 0 ? static_cast<std::size_t>(Dim) : 0); ++d) {
+      // Round to nearest by truncation of q +- 1/2 (inline, unlike llround).
+      const double q = geometry[d] * 1048576.0;
+      k = hash_mix(k, static_cast<std::uint64_t>(static_cast<std::int64_t>(q < 0.0 ? q - 0.5 : q + 0.5)));
+    }
+    key = hash_mix(k, std::bit_cast<std::uint64_t>(volume) >> 32);
   }
 };
 
@@ -205,7 +224,8 @@ CorrectedOperator<Dim> build_corrected_operator(const std::vector<Vec<Dim>>& tar
                                                 const OperatorOptions& options) {
   constexpr std::size_t G = Dim + 1;
   const double h = kernel.h();
-  const CellList<Dim> cells(sources.position, kernel.support_radius());
+  // Half-radius cells: 30 % fewer candidates to test than radius-sized ones (2D).
+  const CellList<Dim> cells(sources.position, kernel.support_radius(), 2);
   const double r_max = kernel.support_radius() * (1.0 - kSupportGap);
   const auto nt = static_cast<Index>(targets.size());
   const bool share = options.share_patterns;
@@ -237,11 +257,7 @@ CorrectedOperator<Dim> build_corrected_operator(const std::vector<Vec<Dim>>& tar
       const Index end = std::min(nt, (blk + 1) * kBuildBlock);
       for (Index a = blk * kBuildBlock; a < end; ++a) {
         const auto au = static_cast<std::size_t>(a);
-        row.pairs.clear();
-        cells.for_each_neighbour(targets[au], [&](Index b, const Vec<Dim>& x_ab, double r) {
-          if (r < r_max) row.pairs.push_back({b, x_ab, r});
-        });
-        std::sort(row.pairs.begin(), row.pairs.end(), [](const auto& p, const auto& q) { return p.b < q.b; });
+        row.gather(cells, targets[au], r_max);
         row.finish(sources, h);
         const std::size_t n = row.pairs.size();
         base[au] = n > 0 ? row.pairs[0].b : 0;
