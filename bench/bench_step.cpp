@@ -1,9 +1,11 @@
 // Throughput of the V1 time step and of its set-up (neighbour search + operator assembly),
 // with the memory it holds per node and a STREAM-like triad for the machine's bandwidth.
+//   scripts/bench.sh            (table + bench/results/<date>-<revision>.json)
 //   build/bench/rktsph_bench --benchmark_counters_tabular=true
 #include <benchmark/benchmark.h>
 #include <omp.h>
 
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -12,11 +14,32 @@
 #include <fmt/format.h>
 
 #include "case/case_setup.hpp"
+#include "operators/corrected_operator.hpp"
 #include "solvers/staggered_solver.hpp"
 
 namespace {
 
 using namespace rktsph;
+
+// Triad bandwidth of this run, GB/s (BM_Triad is registered first, so it runs first).
+double g_triad_gbs = 0.0;
+
+// STREAM-like triad a = b + s c on arrays far larger than the caches: the bandwidth ceiling.
+void BM_Triad(benchmark::State& state) {
+  const std::size_t n = 1 << 25;  // 3 x 256 MiB
+  std::vector<double> a(n, 0.0), b(n, 1.0), c(n, 2.0);
+  const auto t0 = std::chrono::steady_clock::now();
+  for (auto _ : state) {
+    for (std::size_t i = 0; i < n; ++i) a[i] = b[i] + 3.0 * c[i];
+    benchmark::DoNotOptimize(a.data());
+    benchmark::ClobberMemory();
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const double bytes = 3.0 * 8.0 * static_cast<double>(n) * static_cast<double>(state.iterations());
+  g_triad_gbs = std::max(g_triad_gbs, bytes / seconds / 1e9);
+  state.counters["GB/s"] = benchmark::Counter(bytes / 1e9, benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_Triad)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // A square 2D elastic block with about `nodes` nodes, fixed base, loaded top.
 std::string block_case(long nodes) {
@@ -53,22 +76,53 @@ void BM_V1Step(benchmark::State& state) {
   const CaseDocument doc = load_case_document(block_case(state.range(0)), {});
   CaseSetup<2> setup = read_case<2>(doc);
   StaggeredSolver<2> solver(setup);
+  const auto t0 = std::chrono::steady_clock::now();
   for (auto _ : state) {
     solver.step();
     benchmark::ClobberMemory();
   }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const double nodes = static_cast<double>(solver.particles().nodes.size());
+  const double steps = static_cast<double>(state.iterations());
+  const double traffic = static_cast<double>(solver.step_traffic_bytes());
   state.counters["nodes"] = nodes;
-  state.counters["node_steps/s"] = benchmark::Counter(nodes * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["node_steps/s"] = benchmark::Counter(nodes * steps, benchmark::Counter::kIsRate);
   state.counters["pairs/node"] = static_cast<double>(solver.pairs()) / nodes;
   state.counters["state_B/node"] = static_cast<double>(solver.state_bytes()) / nodes;
   state.counters["operator_B/node"] = static_cast<double>(solver.operator_bytes()) / nodes;
+  state.counters["patterns"] = static_cast<double>(solver.operator_patterns());
   state.counters["threads"] = static_cast<double>(state.range(1));
+  // Effective bandwidth: the step's compulsory traffic (StaggeredSolver::step_traffic_bytes)
+  // over its time, and its fraction of the triad of this run.
+  state.counters["traffic_B/node"] = traffic / nodes;
+  state.counters["GB/s"] = benchmark::Counter(traffic * steps / 1e9, benchmark::Counter::kIsRate);
+  state.counters["of_triad"] = g_triad_gbs > 0.0 ? traffic * steps / seconds / 1e9 / g_triad_gbs : 0.0;
 }
 BENCHMARK(BM_V1Step)->Args({10000, 1})->Args({100000, 1})->Args({100000, 2})->Args({1000000, 1})
-    ->Unit(benchmark::kMillisecond)->UseRealTime();
+    ->Args({1000000, 2})->Unit(benchmark::kMillisecond)->UseRealTime();
 
-// Set-up: lattice generation, cell-list neighbour search and corrected-operator assembly.
+// Neighbour search (cell list) and corrected-operator assembly of both directions, one thread:
+// the set-up the large-deformation version would repeat every step.
+void BM_OperatorSetup(benchmark::State& state) {
+  omp_set_num_threads(1);
+  const CaseDocument doc = load_case_document(block_case(state.range(0)), {});
+  const CaseSetup<2> setup = read_case<2>(doc);
+  const Discretisation<2> disc = discretise<2>(setup.blocks, setup.dx, setup.origin, {2000.0});
+  const CubicSplineKernel<2> kernel(setup.h_over_dx * setup.dx);
+  for (auto _ : state) {
+    const auto en = build_corrected_operator<2>(disc.elements.position, disc.nodes, kernel);
+    const auto ne = build_corrected_operator<2>(disc.nodes.position, disc.elements, kernel);
+    benchmark::DoNotOptimize(en.base.data());
+    benchmark::DoNotOptimize(ne.base.data());
+  }
+  const double nodes = static_cast<double>(disc.nodes.size());
+  state.counters["nodes"] = nodes;
+  state.counters["us/node"] = benchmark::Counter(nodes * static_cast<double>(state.iterations()),
+                                                 benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_OperatorSetup)->Arg(100000)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The whole set-up of a run: case reading, lattice generation, operators, constraints, state.
 void BM_V1Setup(benchmark::State& state) {
   omp_set_num_threads(1);
   const CaseDocument doc = load_case_document(block_case(state.range(0)), {});
@@ -81,23 +135,9 @@ void BM_V1Setup(benchmark::State& state) {
   }
   state.counters["nodes"] = nodes;
   state.counters["us/node"] = benchmark::Counter(nodes * static_cast<double>(state.iterations()),
-                                                 benchmark::Counter::kIsRate | benchmark::Counter::kInvert) ;
+                                                 benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(BM_V1Setup)->Arg(100000)->Unit(benchmark::kMillisecond)->UseRealTime();
-
-// STREAM-like triad a = b + s c on arrays far larger than the caches: the bandwidth ceiling.
-void BM_Triad(benchmark::State& state) {
-  const std::size_t n = 1 << 25;  // 3 x 256 MiB
-  std::vector<double> a(n, 0.0), b(n, 1.0), c(n, 2.0);
-  for (auto _ : state) {
-    for (std::size_t i = 0; i < n; ++i) a[i] = b[i] + 3.0 * c[i];
-    benchmark::DoNotOptimize(a.data());
-    benchmark::ClobberMemory();
-  }
-  state.counters["GB/s"] = benchmark::Counter(3.0 * 8.0 * static_cast<double>(n) * static_cast<double>(state.iterations()) / 1e9,
-                                              benchmark::Counter::kIsRate);
-}
-BENCHMARK(BM_Triad)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
 

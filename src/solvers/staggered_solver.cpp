@@ -688,6 +688,35 @@ std::size_t StaggeredSolver<Dim>::operator_bytes() const {
          diff_row_of_node_.size() * sizeof(Index);
 }
 
+template <int Dim>
+std::size_t StaggeredSolver<Dim>::step_traffic_bytes() const {
+  // A model of the compulsory traffic of step() for V1 with the default velocity filter (the
+  // gathers are assumed to hit the cache after a particle's first use, which lattice order
+  // gives): per pass, the arrays it reads plus those it writes, reads and writes counted apart.
+  const auto nn = static_cast<std::size_t>(disc_.nodes.size());
+  const auto ne = static_cast<std::size_t>(disc_.elements.size());
+  constexpr std::size_t phi = NV * sizeof(double), vec = Dim * sizeof(double);
+  const std::size_t props = sizeof(double) + sizeof(int);  // density, material
+  const std::size_t hist = static_cast<std::size_t>(state_stride_) * sizeof(double);
+  const std::size_t src = any_source_ ? 2 * NS * sizeof(double) : 0;  // sigma_start, rate
+  const std::size_t row_en = op_en_.bytes() - op_en_.interp.size() * sizeof(double) - op_en_.grad.size() * sizeof(op_en_.grad[0]);
+  const std::size_t row_ne = op_ne_.bytes() - op_ne_.interp.size() * sizeof(double) - op_ne_.grad.size() * sizeof(op_ne_.grad[0]);
+  std::size_t bytes = 0;
+  // step_elements: phi_N, history_N -> phi_E, history_E (+ source inputs)
+  bytes += nn * (phi + hist) + ne * (phi + hist + props + src) + row_en;
+  // step_nodes: phi_E, phi_N -> phi_N, v_prev (+ source inputs)
+  bytes += ne * phi + nn * (2 * phi + vec + props + sizeof(Index) + src) + row_ne;
+  if (setup_.filter) {
+    bytes += nn * phi + ne * vec + row_en;              // P_EN v
+    bytes += ne * vec + nn * (phi + vec) + row_ne;      // v - P_NE P_EN v
+    bytes += nn * vec + ne * vec + row_en;              // P_EN of that
+    bytes += ne * vec + nn * (vec + 2 * phi) + row_ne;  // v -= eps (...)
+  }
+  // finish_step: volume, density, v, u, v_prev -> u
+  bytes += nn * (2 * sizeof(double) + phi + 2 * vec + vec);
+  return bytes;
+}
+
 template class StaggeredSolver<1>;
 template class StaggeredSolver<2>;
 

@@ -82,6 +82,11 @@ class StaggeredSolver {
   std::size_t state_bytes() const;
   std::size_t operator_bytes() const;
   std::size_t pairs() const { return op_en_.pairs() + op_ne_.pairs(); }
+  /// Shared row patterns of the two cross-set operators (operators/corrected_operator.hpp).
+  Index operator_patterns() const { return op_en_.patterns() + op_ne_.patterns(); }
+  /// Bytes one V1 step must move at least (each array a pass streams, counted once per pass):
+  /// the benchmark divides it by the step time for the effective memory bandwidth.
+  std::size_t step_traffic_bytes() const;
   Index degenerate_operator_rows() const { return op_en_.degenerate_rows + op_ne_.degenerate_rows; }
   long max_source_substeps() const { return max_substeps_; }
   /// Damping coefficient in force at time t: c_d before damping.until and before the
