@@ -302,6 +302,15 @@ CorrectedOperator<Dim> build_corrected_operator(const std::vector<Vec<Dim>>& tar
   op.offset = std::move(all.offset);
   op.interp = std::move(all.interp);
   op.grad = std::move(all.grad);
+  op.run_start.push_back(0);
+  for (Index a = 1; a < nt; ++a) {
+    const auto au = static_cast<std::size_t>(a);
+    if (a - op.run_start.back() >= CorrectedOperator<Dim>::kMaxRun || op.pattern[au] != op.pattern[au - 1] ||
+        op.base[au] != op.base[au - 1] + 1) {
+      op.run_start.push_back(a);
+    }
+  }
+  if (nt > 0) op.run_start.push_back(nt);
   for (Index a = 0; a < nt; ++a) {
     const auto p = static_cast<std::size_t>(op.pattern[static_cast<std::size_t>(a)]);
     op.pair_count += static_cast<std::size_t>(op.pattern_start[p + 1] - op.pattern_start[p]);

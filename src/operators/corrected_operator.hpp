@@ -43,6 +43,11 @@ struct CorrectedOperator {
   std::vector<Index> offset;
   std::vector<double> interp;
   std::vector<GradWeights> grad;
+  // Runs of at most kMaxRun consecutive rows with one pattern and consecutive bases: for each
+  // pair k the sources of a run's m rows are m consecutive particles, so a loop over a run
+  // sums contiguous blocks with vector instructions (the rows of one lattice line).
+  static constexpr Index kMaxRun = 16;
+  std::vector<Index> run_start;  // rows of run r: [run_start[r], run_start[r+1])
   Index degenerate_rows = 0;   // rows that fell back to Shepard / uncorrected (too few sources)
   std::size_t pair_count = 0;  // pairs summed over all rows (the uncompressed CSR length)
 
@@ -56,6 +61,7 @@ struct CorrectedOperator {
 
   Index rows() const { return static_cast<Index>(base.size()); }
   Index patterns() const { return static_cast<Index>(pattern_start.size()) - 1; }
+  Index runs() const { return static_cast<Index>(run_start.size()) - 1; }
   std::size_t pairs() const { return pair_count; }
   Row row(Index a) const {
     const auto p = static_cast<std::size_t>(pattern[static_cast<std::size_t>(a)]);
@@ -63,7 +69,7 @@ struct CorrectedOperator {
   }
   Index source(const Row& r, Index k) const { return r.base + offset[static_cast<std::size_t>(k)]; }
   std::size_t bytes() const {
-    return (base.size() + pattern.size() + pattern_start.size() + offset.size()) * sizeof(Index) +
+    return (base.size() + pattern.size() + pattern_start.size() + offset.size() + run_start.size()) * sizeof(Index) +
            interp.size() * sizeof(double) + grad.size() * sizeof(GradWeights);
   }
 };

@@ -57,6 +57,44 @@ constexpr Index kReductionBlock = 4096;  // fixed blocks: sums independent of th
 // Below this many particles a loop runs on one thread: the fork/join costs more than it saves.
 constexpr Index kParallelMin = 2048;
 
+// Sums over one run of an operator (CorrectedOperator::run_start): rows r0..r0+m-1 share a
+// pattern and have consecutive bases, so pair k reads the same weights for every row, from the
+// contiguous block src[(base + off[k]) * stride, ...) of len = m * stride doubles. Output q of
+// slot i is
+//   acc[q][i] = sum_k w_q[k] src[(base + off[k]) * stride + i],
+// with weights(k, w) giving w_0..w_{NW-1} of pair k. The sum runs over k in pattern order for
+// every slot, as a per-row loop would, but L slots at a time: the block loop is vector FMAs
+// with NW * L / 8 independent accumulators in registers (enough to hide the FMA latency),
+// where a per-row loop over a few state components does not vectorise.
+template <int NW, std::size_t L, class Weights>
+inline void run_sums(const double* src, std::size_t stride, std::size_t len, const Index* off, Index k0, Index k1,
+                     Weights&& weights, double* const* acc) {
+  std::size_t i0 = 0;
+  auto block = [&](std::size_t width, auto fixed) {
+    constexpr bool kFull = decltype(fixed)::value;
+    double a[NW][L] = {};
+    for (Index k = k0; k < k1; ++k) {
+      const double* s = src + static_cast<std::size_t>(off[k]) * stride + i0;
+      double w[NW];
+      weights(k, w);
+      if constexpr (kFull) {
+        for (std::size_t l = 0; l < L; ++l) {
+          for (int q = 0; q < NW; ++q) a[q][l] += w[q] * s[l];
+        }
+      } else {
+        for (std::size_t l = 0; l < width; ++l) {
+          for (int q = 0; q < NW; ++q) a[q][l] += w[q] * s[l];
+        }
+      }
+    }
+    for (int q = 0; q < NW; ++q) {
+      for (std::size_t l = 0; l < width; ++l) acc[q][i0 + l] = a[q][l];
+    }
+  };
+  for (; i0 + L <= len; i0 += L) block(L, std::true_type{});
+  if (i0 < len) block(len - i0, std::false_type{});
+}
+
 }  // namespace
 
 template <int Dim>
@@ -373,47 +411,57 @@ void StaggeredSolver<Dim>::step_elements(double t) {
   const auto* wg = op_en_.grad.data();
   const double* nphi = node_phi_.data();
   const int stride = state_stride_;
+  constexpr std::size_t kRunLen = CorrectedOperator<Dim>::kMaxRun * NV;
+  const Index* runs = op_en_.run_start.data();
+  const Index nruns = op_en_.runs();
 #pragma omp parallel for schedule(static) if (ne > kParallelMin)
-  for (Index e = 0; e < ne; ++e) {
-    double bar[NV] = {};
-    double grad[Dim][NV] = {};
-    const Index k0 = pstart[pat[e]], k1 = pstart[pat[e] + 1];
-    const double* row_phi = nphi + static_cast<std::size_t>(base[e]) * NV;
-    for (Index k = k0; k < k1; ++k) {
-      const double* p = row_phi + static_cast<std::size_t>(off[k]) * NV;
-      const double w0 = wi[k];
-      const auto& wk = wg[k];
+  for (Index r = 0; r < nruns; ++r) {
+    // Interpolated state (slot 0) and its gradient (slots 1..Dim) of the run's elements.
+    double acc[Dim + 1][kRunLen];
+    const Index e0 = runs[r], e1 = runs[r + 1];
+    const Index k0 = pstart[pat[e0]], k1 = pstart[pat[e0] + 1];
+    double* sums[Dim + 1];
+    for (int q = 0; q <= Dim; ++q) sums[q] = acc[q];
+    run_sums<Dim + 1, 16>(nphi + static_cast<std::size_t>(base[e0]) * NV, NV, static_cast<std::size_t>(e1 - e0) * NV,
+                          off, k0, k1, [&](Index k, double* w) {
+                            w[0] = wi[k];
+                            for (int d = 0; d < Dim; ++d) w[1 + d] = wg[k][static_cast<std::size_t>(d)];
+                          }, sums);
+    for (Index e = e0; e < e1; ++e) {
+      const auto slot0 = static_cast<std::size_t>(e - e0) * NV;
+      double bar[NV];
+      double grad[Dim][NV];
       for (int c = 0; c < NV; ++c) {
-        bar[c] += w0 * p[c];
-        for (int d = 0; d < Dim; ++d) grad[d][c] += wk[static_cast<std::size_t>(d)] * p[c];
+        bar[c] = acc[0][slot0 + static_cast<std::size_t>(c)];
+        for (int d = 0; d < Dim; ++d) grad[d][c] = acc[1 + d][slot0 + static_cast<std::size_t>(c)];
       }
-    }
-    const auto eu = static_cast<std::size_t>(e);
-    const auto m = static_cast<std::size_t>(disc_.elements.material[eu]);
-    double dv[Dim], dsig[NS];
-    flux_rates<Dim>(grad, 1.0 / disc_.elements.density[eu], lambda_[m], shear_[m], dv, dsig);
-    if (saturated_) {  // V3 (METHOD.md §5.3): -grad p^n / rho in the element half-step
-      for (Index k = k0; k < k1; ++k) {
-        const double pr = pw_[static_cast<std::size_t>(base[e] + off[k])] / disc_.elements.density[eu];
-        for (int d = 0; d < Dim; ++d) dv[d] -= wg[k][static_cast<std::size_t>(d)] * pr;
+      const auto eu = static_cast<std::size_t>(e);
+      const auto m = static_cast<std::size_t>(disc_.elements.material[eu]);
+      double dv[Dim], dsig[NS];
+      flux_rates<Dim>(grad, 1.0 / disc_.elements.density[eu], lambda_[m], shear_[m], dv, dsig);
+      if (saturated_) {  // V3 (METHOD.md §5.3): -grad p^n / rho in the element half-step
+        for (Index k = k0; k < k1; ++k) {
+          const double pr = pw_[static_cast<std::size_t>(base[e] + off[k])] / disc_.elements.density[eu];
+          for (int d = 0; d < Dim; ++d) dv[d] -= wg[k][static_cast<std::size_t>(d)] * pr;
+        }
       }
-    }
-    double* out = &elem_phi_[eu * NV];
-    for (int i = 0; i < Dim; ++i) out[i] = damped_velocity(bar[i], dv[i] + b[i], cd, tau);
-    for (int s = 0; s < NS; ++s) out[Dim + s] = bar[Dim + s] + tau * dsig[s];
-    if (any_source_) {
-      for (int s = 0; s < NS; ++s) {
-        src_sigma_start_[eu * NS + static_cast<std::size_t>(s)] = bar[Dim + s];
-        src_rate_[eu * NS + static_cast<std::size_t>(s)] = dsig[s];
+      double* out = &elem_phi_[eu * NV];
+      for (int i = 0; i < Dim; ++i) out[i] = damped_velocity(bar[i], dv[i] + b[i], cd, tau);
+      for (int s = 0; s < NS; ++s) out[Dim + s] = bar[Dim + s] + tau * dsig[s];
+      if (any_source_) {
+        for (int s = 0; s < NS; ++s) {
+          src_sigma_start_[eu * NS + static_cast<std::size_t>(s)] = bar[Dim + s];
+          src_rate_[eu * NS + static_cast<std::size_t>(s)] = dsig[s];
+        }
       }
-    }
-    if (stride > 0) {
-      // History variables are interpolated from the nodes (METHOD.md §3.3: nodes are primary).
-      double* ks = &elem_state_[eu * static_cast<std::size_t>(stride)];
-      for (int j = 0; j < stride; ++j) ks[j] = 0.0;
-      for (Index k = k0; k < k1; ++k) {
-        const double* kn = &node_state_[static_cast<std::size_t>(base[e] + off[k]) * static_cast<std::size_t>(stride)];
-        for (int j = 0; j < stride; ++j) ks[j] += wi[k] * kn[j];
+      if (stride > 0) {
+        // History variables are interpolated from the nodes (METHOD.md §3.3: nodes are primary).
+        double* ks = &elem_state_[eu * static_cast<std::size_t>(stride)];
+        for (int j = 0; j < stride; ++j) ks[j] = 0.0;
+        for (Index k = k0; k < k1; ++k) {
+          const double* kn = &node_state_[static_cast<std::size_t>(base[e] + off[k]) * static_cast<std::size_t>(stride)];
+          for (int j = 0; j < stride; ++j) ks[j] += wi[k] * kn[j];
+        }
       }
     }
   }
@@ -435,50 +483,58 @@ void StaggeredSolver<Dim>::step_nodes(double t) {
   const Index* off = op_ne_.offset.data();
   const auto* wg = op_ne_.grad.data();
   const double* ephi = elem_phi_.data();
+  constexpr std::size_t kRunLen = CorrectedOperator<Dim>::kMaxRun * NV;
+  const Index* runs = op_ne_.run_start.data();
+  const Index nruns = op_ne_.runs();
 #pragma omp parallel for schedule(static) if (nn > kParallelMin)
-  for (Index i = 0; i < nn; ++i) {
-    double grad[Dim][NV] = {};
-    const double* row_phi = ephi + static_cast<std::size_t>(base[i]) * NV;
-    for (Index k = pstart[pat[i]]; k < pstart[pat[i] + 1]; ++k) {
-      const double* p = row_phi + static_cast<std::size_t>(off[k]) * NV;
-      const auto& wk = wg[k];
+  for (Index r = 0; r < nruns; ++r) {
+    double acc[Dim][kRunLen];  // gradient of the state at the run's nodes
+    const Index i0 = runs[r], i1 = runs[r + 1];
+    double* sums[Dim];
+    for (int q = 0; q < Dim; ++q) sums[q] = acc[q];
+    run_sums<Dim, 16>(ephi + static_cast<std::size_t>(base[i0]) * NV, NV, static_cast<std::size_t>(i1 - i0) * NV, off,
+                      pstart[pat[i0]], pstart[pat[i0] + 1], [&](Index k, double* w) {
+                        for (int d = 0; d < Dim; ++d) w[d] = wg[k][static_cast<std::size_t>(d)];
+                      }, sums);
+    for (Index i = i0; i < i1; ++i) {
+      double grad[Dim][NV];
       for (int c = 0; c < NV; ++c) {
-        for (int d = 0; d < Dim; ++d) grad[d][c] += wk[static_cast<std::size_t>(d)] * p[c];
+        for (int d = 0; d < Dim; ++d) grad[d][c] = acc[d][static_cast<std::size_t>(i - i0) * NV + static_cast<std::size_t>(c)];
       }
-    }
-    const auto iu = static_cast<std::size_t>(i);
-    const Index drow = diff_row_of_node_[iu];
-    if (drow >= 0) {
-      // METHOD.md §0.3 fix (a): a prescribed component enters its own gradient through the
-      // difference form with fhat = the prescribed value at t^{n+1/2}.
-      const auto dr = static_cast<std::size_t>(drow);
-      for (Index q = constraint_row_[iu]; q < constraint_row_[iu + 1]; ++q) {
-        const NodalConstraint& con = constraints_[static_cast<std::size_t>(q)];
-        const double fhat = constraint_value(iu, con, t_half);
-        double g[Dim] = {};
-        for (Index k = diff_ne_.row_start[dr]; k < diff_ne_.row_start[dr + 1]; ++k) {
-          const double f = ephi[static_cast<std::size_t>(diff_ne_.source[static_cast<std::size_t>(k)]) * NV +
-                                static_cast<std::size_t>(con.component)];
-          for (int d = 0; d < Dim; ++d) g[d] += diff_ne_.weight[static_cast<std::size_t>(k)][d] * f;
+      const auto iu = static_cast<std::size_t>(i);
+      const Index drow = diff_row_of_node_[iu];
+      if (drow >= 0) {
+        // METHOD.md §0.3 fix (a): a prescribed component enters its own gradient through the
+        // difference form with fhat = the prescribed value at t^{n+1/2}.
+        const auto dr = static_cast<std::size_t>(drow);
+        for (Index q = constraint_row_[iu]; q < constraint_row_[iu + 1]; ++q) {
+          const NodalConstraint& con = constraints_[static_cast<std::size_t>(q)];
+          const double fhat = constraint_value(iu, con, t_half);
+          double g[Dim] = {};
+          for (Index k = diff_ne_.row_start[dr]; k < diff_ne_.row_start[dr + 1]; ++k) {
+            const double f = ephi[static_cast<std::size_t>(diff_ne_.source[static_cast<std::size_t>(k)]) * NV +
+                                  static_cast<std::size_t>(con.component)];
+            for (int d = 0; d < Dim; ++d) g[d] += diff_ne_.weight[static_cast<std::size_t>(k)][d] * f;
+          }
+          for (int d = 0; d < Dim; ++d) grad[d][con.component] = g[d] - diff_ne_.weight_sum[dr][d] * fhat;
         }
-        for (int d = 0; d < Dim; ++d) grad[d][con.component] = g[d] - diff_ne_.weight_sum[dr][d] * fhat;
       }
-    }
-    const auto m = static_cast<std::size_t>(disc_.nodes.material[iu]);
-    double dv[Dim], dsig[NS];
-    flux_rates<Dim>(grad, 1.0 / disc_.nodes.density[iu], lambda_[m], shear_[m], dv, dsig);
-    double* phi = &node_phi_[iu * NV];
-    for (int d = 0; d < Dim; ++d) {
-      v_prev_[iu * Dim + static_cast<std::size_t>(d)] = phi[d];
-      phi[d] = damped_velocity(phi[d], dv[d] + b[d], cd, dt_);
-    }
-    if (any_source_) {
-      for (int s = 0; s < NS; ++s) {
-        src_sigma_start_[iu * NS + static_cast<std::size_t>(s)] = phi[Dim + s];
-        src_rate_[iu * NS + static_cast<std::size_t>(s)] = dsig[s];
+      const auto m = static_cast<std::size_t>(disc_.nodes.material[iu]);
+      double dv[Dim], dsig[NS];
+      flux_rates<Dim>(grad, 1.0 / disc_.nodes.density[iu], lambda_[m], shear_[m], dv, dsig);
+      double* phi = &node_phi_[iu * NV];
+      for (int d = 0; d < Dim; ++d) {
+        v_prev_[iu * Dim + static_cast<std::size_t>(d)] = phi[d];
+        phi[d] = damped_velocity(phi[d], dv[d] + b[d], cd, dt_);
       }
+      if (any_source_) {
+        for (int s = 0; s < NS; ++s) {
+          src_sigma_start_[iu * NS + static_cast<std::size_t>(s)] = phi[Dim + s];
+          src_rate_[iu * NS + static_cast<std::size_t>(s)] = dsig[s];
+        }
+      }
+      for (int s = 0; s < NS; ++s) phi[Dim + s] += dt_ * dsig[s];
     }
-    for (int s = 0; s < NS; ++s) phi[Dim + s] += dt_ * dsig[s];
   }
   if (any_source_) integrate_sources(dt_, false);
 }
@@ -491,17 +547,27 @@ void StaggeredSolver<Dim>::filter_velocity() {
   const Index nn = disc_.nodes.size();
   const double eps = setup_.filter_strength;
   auto to_elements = [&](const double* node_field, std::size_t node_stride) {
+    // By runs (run_sums): all node_stride components of the run's sources are summed, of which
+    // the first Dim are kept; the vector loop is still cheaper than a per-row gather.
+    const Index* runs = op_en_.run_start.data();
+    const Index nruns = op_en_.runs();
 #pragma omp parallel for schedule(static) if (ne > kParallelMin)
-    for (Index e = 0; e < ne; ++e) {
-      double acc[Dim] = {};
-      const auto r = op_en_.row(e);
-      const double* row_field = node_field + static_cast<std::size_t>(r.base) * node_stride;
-      for (Index k = r.begin; k < r.end; ++k) {
-        const double wk = op_en_.interp[static_cast<std::size_t>(k)];
-        const double* p = row_field + static_cast<std::size_t>(op_en_.offset[static_cast<std::size_t>(k)]) * node_stride;
-        for (int d = 0; d < Dim; ++d) acc[d] += wk * p[d];
+    for (Index r = 0; r < nruns; ++r) {
+      double acc[CorrectedOperator<Dim>::kMaxRun * NV];
+      double* sums[1] = {acc};
+      const Index e0 = runs[r], e1 = runs[r + 1];
+      const auto e0u = static_cast<std::size_t>(e0);
+      const auto p = static_cast<std::size_t>(op_en_.pattern[e0u]);
+      run_sums<1, 16>(node_field + static_cast<std::size_t>(op_en_.base[e0u]) * node_stride, node_stride,
+                      static_cast<std::size_t>(e1 - e0) * node_stride, op_en_.offset.data(), op_en_.pattern_start[p],
+                      op_en_.pattern_start[p + 1], [&](Index k, double* w) { w[0] = op_en_.interp[static_cast<std::size_t>(k)]; },
+                      sums);
+      for (Index e = e0; e < e1; ++e) {
+        for (int d = 0; d < Dim; ++d) {
+          filter_elem_[static_cast<std::size_t>(e) * Dim + static_cast<std::size_t>(d)] =
+              acc[static_cast<std::size_t>(e - e0) * node_stride + static_cast<std::size_t>(d)];
+        }
       }
-      for (int d = 0; d < Dim; ++d) filter_elem_[static_cast<std::size_t>(e) * Dim + static_cast<std::size_t>(d)] = acc[d];
     }
   };
   auto back_to_nodes = [&](Index i, double* acc) {
