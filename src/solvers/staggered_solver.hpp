@@ -120,7 +120,7 @@ class StaggeredSolver {
   void step_nodes(double t);
   void filter_velocity();
   void apply_constraints(double t);
-  void finish_step(const double* v_prev);
+  void finish_step();
   double boundary_power() const;
   void integrate_sources(double tau, bool on_elements);
   // V3 hooks (solvers/staggered_saturated.cpp)
@@ -163,7 +163,7 @@ class StaggeredSolver {
   std::vector<std::array<Index, 3>> node_runs_, elem_runs_;
 
   // scratch, sized once
-  std::vector<double> v_prev_, filter_elem_, filter_node_;
+  std::vector<double> v_half_, filter_elem_, filter_node_;  // v_half_: material velocity at t^{n+1/2}, nodes
   std::vector<double> src_sigma_start_, src_rate_, src_state_start_;
   std::vector<double> block_sums_;
 
