@@ -39,6 +39,7 @@ int run_validation(const Options& opt) {
       {"06", validate_case06},
       {"13", validate_case13},
       {"14", validate_case14},
+      {"15", validate_case15},
   };
   fs::create_directories(opt.out_dir);
   std::vector<CaseReport> reports;
