@@ -39,6 +39,8 @@ int run_validation(const Options& opt) {
       {"06", validate_case06},
       {"13", validate_case13},
       {"14", validate_case14},
+      {"16", validate_case16},
+      {"17", validate_case17},
   };
   fs::create_directories(opt.out_dir);
   std::vector<CaseReport> reports;
