@@ -396,14 +396,30 @@ CaseReport validate_case16(const Options& opt, const std::string& dir) {
   rep.metrics.push_back(metric("k = 1e-6 m/s: particles in the band (eps >= 50 % max)", loc.band.particles, "", 0, ""));
   rep.metrics.push_back(metric("k = 1e-6 m/s: coefficient of variation of eps_vp_eq " + te + " (all nodes)", loc.cov_eps, "",
                                0, ""));
-  rep.metrics.push_back(metric("k = 1e-6 m/s: mean p_w in the band - mean p_w within 0.2 m around it (must be < 0)",
-                               (loc.pw_band - loc.pw_around) / 1e3, "<=", 0.0, "kPa"));
+  {
+    Metric m = metric("k = 1e-6 m/s: mean p_w in the band - mean p_w within 0.2 m around it (must be < 0)",
+                      (loc.pw_band - loc.pw_around) / 1e3, "<=", 0.0, "kPa");
+    if (!m.pass()) {
+      m.known_deviation = fmt::format(
+          "open: the k = 1e-6 and 1e-9 runs give the same p_w field (band minus surroundings {:+.2f} and {:+.2f} kPa), so "
+          "what is measured is not water drawn in by the permeability; the same suspected cause as the CoV of eps_vp_eq "
+          "at k = 1e-9 (the non-incremental projection's wall leak)",
+          (loc.pw_band - loc.pw_around) / 1e3, (und.pw_band - und.pw_around) / 1e3);
+    }
+    rep.metrics.push_back(m);
+  }
   rep.notes.push_back(fmt::format(
       "k = 1e-6 m/s band {}: {} particles, angle {:.1f} deg (arms {:.1f} / {:.1f}, whole cloud {:.1f}), axis {:.3f} m "
       "from the imperfection centre; mean p_w {:.2f} kPa in the band, {:.2f} kPa in the {} nodes around it",
       loc.band.pair ? "(conjugate pair, angle = mean of the arms)" : "(single band, angle = principal axis of the cloud)",
       loc.band.particles, loc.band.angle, loc.band.upper, loc.band.lower, loc.band.whole, loc.band.offset,
       loc.pw_band / 1e3, loc.pw_around / 1e3, loc.around_count));
+  if (loc.band.particles < 30) {
+    rep.notes.push_back(fmt::format("k = 1e-6 m/s: the cloud above 50 % of the maximum eps_vp_eq has only {} particles: it "
+                                    "is the imperfection zone, not a developed band, so the band angle and the p_w "
+                                    "comparison refer to that zone; read the maps",
+                                    loc.band.particles));
+  }
   rep.notes.push_back(fmt::format(
       "k = 1e-9 m/s band fit for comparison: {} particles, angle {:.1f} deg; mean p_w in that cloud {:.2f} kPa, around "
       "it {:.2f} kPa",
