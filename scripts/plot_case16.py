@@ -24,7 +24,7 @@ def main(d):
     q_y, p_y, pw_y, e_y = meta["q_y"][0], meta["p_y"][0], meta["dpw_y"][0], meta["eps_y"][0]
     p_f, q_f = meta["p_f"][0], meta["q_f"][0]
 
-    fig, axes = plt.subplots(1, 3, figsize=(17, 4.6))
+    fig, axes = plt.subplots(1, 4, figsize=(22, 4.6))
     for tag, lab in RUNS:
         p = d / f"history_{tag}.csv"
         if not p.exists():
@@ -34,6 +34,8 @@ def main(d):
         axes[0].plot(e, [v / 1e3 for v in h["q"]], label=f"RKT-SPH V3, {lab}")
         axes[1].plot(e, [v / 1e3 for v in h["p"]], label=f"RKT-SPH V3, {lab}")
         axes[2].plot(e, [v / 1e3 for v in h["dpw"]], label=f"RKT-SPH V3, {lab}")
+        if "eps_vp_eq_cov" in h:
+            axes[3].plot(e, h["eps_vp_eq_cov"], label=f"RKT-SPH V3, {lab}")
     ce = [100 * s for s in cf["strain"]]
     for ax, key, yv in ((axes[0], "q", q_y), (axes[1], "p", p_y), (axes[2], "dpw", pw_y)):
         ax.plot(ce, [v / 1e3 for v in cf[key]], "k--", label="closed-form undrained elastic path")
@@ -43,6 +45,9 @@ def main(d):
     axes[0].set_ylabel("q of the average stress (kPa)")
     axes[1].set_ylabel("p' of the average effective stress (kPa)")
     axes[2].set_ylabel("mean excess pore pressure $\\Delta p_w$ (kPa)")
+    axes[3].axhline(0.2, color="r", ls=":", label="CASES.md no-band limit at 8 % (k = 1e-9)")
+    axes[3].set_ylabel("coefficient of variation of $\\bar\\varepsilon^{vp}$ (-)")
+    axes[3].set_ylim(0, 2)
     for ax in axes:
         ax.set_xlabel("axial strain $\\varepsilon_a$ (%)")
         ax.grid(alpha=0.3)
