@@ -414,6 +414,7 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     c.fluid.max_iterations = static_cast<int>(s->integer("pressure_max_iterations", 2000));
     s->require(c.fluid.max_iterations >= 1, "pressure_max_iterations", "must be >= 1");
     c.fluid.deferred_correction = s->boolean("pressure_deferred_correction", true);
+    c.fluid.incremental = s->boolean("pressure_incremental", false);
     const std::string scheme = s->string("scheme", "staggered");
     if (scheme == "staggered") c.scheme = Scheme::staggered;
     else if (scheme == "collocated") c.scheme = Scheme::collocated;

@@ -59,6 +59,9 @@ struct FluidSpec {
   int max_iterations = 2000;
   bool incomplete_cholesky = false;      // preconditioner: false = Jacobi (default)
   bool deferred_correction = true;       // Schwaiger correction on the right-hand side
+  /// Incremental pressure projection (METHOD.md §2.4 "Incremental variant"): the stabilisation
+  /// (S_w dt/rho) L acts on p^{n+1} - p^n instead of p^{n+1}.
+  bool incremental = false;
   double initial_pore_pressure = 0.0;    // Pa, uniform
   /// 1/Q* = S_w n / K_f + (1 - n)/K_s (METHOD.md §1.4), 1/Pa
   double inverse_storage() const {

@@ -22,6 +22,7 @@ struct PorePressureSolver::Impl {
   Sparse K;        // free-free block of I/(Q dt) - k_eff S
   Sparse S_fd;     // free rows, drained columns of S (Dirichlet values to the right-hand side)
   Sparse D;        // free rows of L - S, all columns (deferred correction)
+  Sparse S_f;      // free rows of L (S without the deferred correction), all columns (incremental projection)
   Eigen::ConjugateGradient<Sparse, Eigen::Lower, Eigen::DiagonalPreconditioner<double>> cg_diag;
   Eigen::ConjugateGradient<Sparse, Eigen::Lower, Eigen::IncompleteCholesky<double>> cg_ic;
   Eigen::VectorXd rhs, x, p_all, p_d;
@@ -48,7 +49,7 @@ PorePressureSolver::PorePressureSolver(const Sparse& full, const Sparse& symmetr
   }
   const auto nf = static_cast<Eigen::Index>(free_.size());
   using Triplet = Eigen::Triplet<double>;
-  std::vector<Triplet> k, sfd, d;
+  std::vector<Triplet> k, sfd, d, sf;
   for (Eigen::Index r = 0; r < nf; ++r) {
     const auto i = static_cast<Eigen::Index>(free_[static_cast<std::size_t>(r)]);
     k.emplace_back(r, r, settings.inv_q_dt);
@@ -60,8 +61,12 @@ PorePressureSolver::PorePressureSolver(const Sparse& full, const Sparse& symmetr
         k.emplace_back(r, index_[j], -settings.k_eff * it.value());
       }
       d.emplace_back(r, it.col(), -it.value());
+      if (settings.incremental > 0.0 && !settings.deferred_correction) sf.emplace_back(r, it.col(), it.value());
     }
-    for (Sparse::InnerIterator it(full, i); it; ++it) d.emplace_back(r, it.col(), it.value());
+    for (Sparse::InnerIterator it(full, i); it; ++it) {
+      d.emplace_back(r, it.col(), it.value());
+      if (settings.incremental > 0.0 && settings.deferred_correction) sf.emplace_back(r, it.col(), it.value());
+    }
   }
   impl_->K.resize(nf, nf);
   impl_->K.setFromTriplets(k.begin(), k.end());
@@ -70,6 +75,8 @@ PorePressureSolver::PorePressureSolver(const Sparse& full, const Sparse& symmetr
   impl_->D.resize(nf, static_cast<Eigen::Index>(n));
   impl_->D.setFromTriplets(d.begin(), d.end());
   impl_->D.prune(0.0, 1e-14);
+  impl_->S_f.resize(nf, static_cast<Eigen::Index>(n));
+  impl_->S_f.setFromTriplets(sf.begin(), sf.end());
   impl_->rhs.resize(nf);
   impl_->x.resize(nf);
   impl_->p_all.resize(static_cast<Eigen::Index>(n));
@@ -110,6 +117,7 @@ void PorePressureSolver::solve(const std::vector<double>& source, const std::vec
   // Drained values at t^{n+1}: -K_fd p_d = k_eff S_fd p_d.
   if (nd > 0) m.rhs.noalias() += settings_.k_eff * (m.S_fd * m.p_d);
   if (settings_.deferred_correction) m.rhs.noalias() += settings_.k_eff * (m.D * m.p_all);
+  if (settings_.incremental > 0.0) m.rhs.noalias() -= settings_.incremental * (m.S_f * m.p_all);
   int iterations = 0;
   double error = 0.0;
   bool ok = false;

@@ -43,6 +43,11 @@ class PorePressureSolver {
     int max_iterations = 2000;
     PressurePreconditioner preconditioner = PressurePreconditioner::diagonal;
     bool deferred_correction = true;  // add k_eff (L - S) p^n to the right-hand side
+    /// Incremental projection: the coefficient c = S_w dt/rho of the stabilisation; solve() then
+    /// adds -c L p^n (-c S p^n without the deferred correction, which then uses k_w alone) to
+    /// the right-hand side, and the caller adds S_w dt div(grad p^n / rho) to `source`, so that
+    /// the stabilisation acts on p^{n+1} - p^n only. 0 = non-incremental (METHOD.md §2.4).
+    double incremental = 0.0;
   };
 
   /// `full` and `symmetric` are L and S (1/m^2); `dirichlet[I]` is true at drained nodes.

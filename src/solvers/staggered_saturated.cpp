@@ -113,6 +113,10 @@ void StaggeredSolver<Dim>::build_saturated() {
   s.preconditioner = fl.incomplete_cholesky ? PressurePreconditioner::incomplete_cholesky
                                             : PressurePreconditioner::diagonal;
   s.deferred_correction = fl.deferred_correction;
+  if (fl.incremental) {
+    s.incremental = fl.saturation * dt_ / rho;
+    pw_grad_.assign(nn * static_cast<std::size_t>(Dim), 0.0);
+  }
   pressure_ = std::make_unique<PorePressureSolver>(lap.full, lap.symmetric, pw_drained_, s);
 }
 
@@ -140,6 +144,42 @@ void StaggeredSolver<Dim>::pressure_step(double t_new) {
     }
     pw_source_[iu] = pw_old_[iu] * inv_q_dt - sw * div;
     if (pw_drained_[iu]) pw_[iu] = pw_value_[iu] * setup_.function_value(pw_function_[iu], t_new);
+  }
+  if (!pw_grad_.empty()) {
+    // Incremental projection (solver.pressure_incremental): add S_w dt div(grad p^n / rho) to the
+    // source; the solver subtracts S_w (dt/rho) L p^n, so the stabilisation acts on p^{n+1} - p^n.
+    // At a static state (v^{n+1} = 0) the pressure equation then reduces to k_w L p = 0: the
+    // mirror (impermeable) rows of L no longer constrain the hydrostatic-like gradient that
+    // carries the load, which in the non-incremental form leaks pore pressure through the walls.
+#pragma omp parallel for schedule(static) if (nn > kParallelMinV3)
+    for (Index i = 0; i < nn; ++i) {
+      const auto iu = static_cast<std::size_t>(i);
+      double g[Dim] = {};
+      for (Index k = pstart[pat[i]]; k < pstart[pat[i] + 1]; ++k) {
+        const double p = pw_old_[static_cast<std::size_t>(base[i] + off[k])];
+        for (int d = 0; d < Dim; ++d) g[d] += wg[k][static_cast<std::size_t>(d)] * p;
+      }
+      for (int d = 0; d < Dim; ++d) pw_grad_[iu * Dim + static_cast<std::size_t>(d)] = g[d] / disc_.nodes.density[iu];
+    }
+    // A prescribed velocity component is not corrected (apply_constraints resets it), so it
+    // carries no pressure-gradient term in v* - (dt/rho) grad p^n either.
+    for (const Index i : constrained_nodes_) {
+      const auto iu = static_cast<std::size_t>(i);
+      for (Index k = constraint_row_[iu]; k < constraint_row_[iu + 1]; ++k) {
+        const NodalConstraint& c = constraints_[static_cast<std::size_t>(k)];
+        if (c.component < Dim) pw_grad_[iu * Dim + static_cast<std::size_t>(c.component)] = 0.0;
+      }
+    }
+#pragma omp parallel for schedule(static) if (nn > kParallelMinV3)
+    for (Index i = 0; i < nn; ++i) {
+      const auto iu = static_cast<std::size_t>(i);
+      double div = 0.0;
+      for (Index k = pstart[pat[i]]; k < pstart[pat[i] + 1]; ++k) {
+        const double* g = &pw_grad_[static_cast<std::size_t>(base[i] + off[k]) * Dim];
+        for (int d = 0; d < Dim; ++d) div += wg[k][static_cast<std::size_t>(d)] * g[d];
+      }
+      pw_source_[iu] += sw * dt_ * div;
+    }
   }
   pressure_->solve(pw_source_, pw_old_, pw_);
   // Velocity correction v^{n+1} = v* - (dt/rho) grad p^{n+1} (same-set corrected gradient).

@@ -179,6 +179,7 @@ class StaggeredSolver {
   // ---- V3 state (empty in V1)
   bool saturated_ = false;
   std::vector<double> pw_, pw_old_, pw_source_;
+  std::vector<double> pw_grad_;       // incremental projection: grad p^n / rho per node (Dim each)
   std::vector<bool> pw_drained_;
   std::vector<double> pw_value_;      // prescribed pore pressure at drained nodes, Pa
   std::vector<int> pw_function_;      // its time function

@@ -11,6 +11,7 @@
 #include "case/case_setup.hpp"
 #include "core/error.hpp"
 #include "solvers/staggered_solver.hpp"
+#include "validation/band_common.hpp"
 #include "validation/validation.hpp"
 
 namespace rktsph::validation {
@@ -67,63 +68,18 @@ struct SampleResult {
   long max_substeps = 0;
 };
 
-// Principal axis (angle to the horizontal, degrees) of the nodes selected by `keep`, and the
-// distance of the imperfection centre (0.04, 1.0) from that axis.
-template <class Keep>
-std::pair<double, double> principal_axis(const Snapshot& s, Keep&& keep, int& count) {
-  double mx = 0.0, my = 0.0;
-  count = 0;
-  for (std::size_t i = 0; i < s.x.size(); ++i) {
-    if (!keep(i)) continue;
-    mx += s.x[i];
-    my += s.y[i];
-    ++count;
-  }
-  if (count < 2) return {NAN, NAN};
-  mx /= count;
-  my /= count;
-  double cxx = 0.0, cyy = 0.0, cxy = 0.0;
-  for (std::size_t i = 0; i < s.x.size(); ++i) {
-    if (!keep(i)) continue;
-    cxx += (s.x[i] - mx) * (s.x[i] - mx);
-    cyy += (s.y[i] - my) * (s.y[i] - my);
-    cxy += (s.x[i] - mx) * (s.y[i] - my);
-  }
-  const double theta = 0.5 * std::atan2(2.0 * cxy, cxx - cyy);  // major axis, (-90, 90] deg
-  const double ux = std::cos(theta), uy = std::sin(theta);
-  return {std::abs(theta) * 180.0 / std::numbers::pi, std::abs((0.04 - mx) * uy - (1.0 - my) * ux)};
-}
-
-// Band angle (CASES.md §1.3): threshold eps_vp_eq at 50 % of its maximum inside the band
-// region, here the sample without the 0.1 m next to each platen (the platen corners
-// concentrate strain by the boundary, not by the band), and fit the principal axis. A
-// conjugate pair (a "<" or ">" from the imperfection) is fitted arm by arm, the arms being
-// the parts of the cloud above and below its centroid; the whole-cloud axis is also given.
+// Band angle (CASES.md §1.3, validation/band_common.hpp): threshold eps_vp_eq at 50 % of its
+// maximum inside the band region, here the sample without the 0.1 m next to each platen, and
+// fit the principal axis (arm by arm for a conjugate pair).
 void band_angle(const Snapshot& s, SampleResult& r) {
-  auto inside = [&](std::size_t i) { return s.y[i] > 0.1 + 1e-9 && s.y[i] < kHeight - 0.1 - 1e-9; };
-  double emax = 0.0;
-  for (std::size_t i = 0; i < s.x.size(); ++i) {
-    if (inside(i)) emax = std::max(emax, s.eps[i]);
-  }
-  auto in_band = [&](std::size_t i) { return inside(i) && s.eps[i] >= 0.5 * emax; };
-  int n = 0;
-  const auto whole = principal_axis(s, in_band, n);
-  r.band_particles = n;
-  r.band_angle_whole = whole.first;
-  double ybar = 0.0;
-  for (std::size_t i = 0; i < s.x.size(); ++i) {
-    if (in_band(i)) ybar += s.y[i] / n;
-  }
-  int nu = 0, nl = 0;
-  const auto upper = principal_axis(s, [&](std::size_t i) { return in_band(i) && s.y[i] >= ybar; }, nu);
-  const auto lower = principal_axis(s, [&](std::size_t i) { return in_band(i) && s.y[i] < ybar; }, nl);
-  r.band_angle_upper = upper.first;
-  r.band_angle_lower = lower.first;
-  r.band_offset = std::min(upper.second, lower.second);
-  // A pair when both arms are inclined alike and the whole cloud is not (a single straight
-  // band gives the same axis for its halves and for the whole).
-  r.pair = std::abs(upper.first - whole.first) > 10.0 && std::abs(upper.first - lower.first) < 15.0;
-  r.band_angle = r.pair ? 0.5 * (upper.first + lower.first) : whole.first;
+  const BandFit b = fit_band(s.x, s.y, s.eps, kHeight, 0.1, 0.04, 1.0);
+  r.band_particles = b.particles;
+  r.band_angle_whole = b.whole;
+  r.band_angle_upper = b.upper;
+  r.band_angle_lower = b.lower;
+  r.band_offset = b.offset;
+  r.pair = b.pair;
+  r.band_angle = b.angle;
 }
 
 SampleResult run_sample(const std::string& case_file, double dx, double end_strain,

@@ -95,6 +95,10 @@ void row_profile(const CutSnapshot& s, const std::vector<double>& field, double 
 /// cloud of CASES.md §1.3), with the maximum taken over nodes with y >= ymin.
 double band_distance_to(const CutSnapshot& s, double px, double py, double ymin);
 
+/// Emergence of the failure surface on the top, m behind the crest: position of the largest
+/// eps_vp_eq on the top row away from the crest region (x <= W - 0.3 H). Defined with case 5.
+double emergence_behind_crest(const CutSnapshot& s, double dx, double W, double H);
+
 /// Write histories t, u_c, u_y crest, kinetic energy as CSV.
 void write_history_csv(const std::string& file, const CutRun& r);
 /// Write a snapshot as CSV (x, y, ux, uy, vx, vy, sxx, syy, sxy, eps_vp_eq).

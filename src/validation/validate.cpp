@@ -40,6 +40,8 @@ int run_validation(const Options& opt) {
       {"13", validate_case13},
       {"14", validate_case14},
       {"15", validate_case15},
+      {"16", validate_case16},
+      {"17", validate_case17},
   };
   fs::create_directories(opt.out_dir);
   std::vector<CaseReport> reports;

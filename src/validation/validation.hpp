@@ -80,6 +80,8 @@ CaseReport validate_case06(const Options& options, const std::string& case_dir);
 CaseReport validate_case13(const Options& options, const std::string& case_dir);
 CaseReport validate_case14(const Options& options, const std::string& case_dir);
 CaseReport validate_case15(const Options& options, const std::string& case_dir);
+CaseReport validate_case16(const Options& options, const std::string& case_dir);
+CaseReport validate_case17(const Options& options, const std::string& case_dir);
 
 /// Run the selected cases and write out_dir/report.md. Returns 0 if all pass, 1 otherwise.
 int run_validation(const Options& options);

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <iostream>
 #include <random>
 
 #include <Eigen/Dense>
@@ -288,6 +289,93 @@ cfl = 0.5
   }
   // T_v = 0.58: every node, walls and corners included, within 2 % of p0.
   EXPECT_LT(worst, 0.02);
+}
+
+// An undrained strip (0.6 m wide, 4 m high, lateral rollers, fixed base, every face
+// impermeable, k = 0) loaded by its own weight: p_w must carry Q/(M+Q) of the total vertical
+// stress, -gamma (H - y), and keep it while the weight is held. The non-incremental projection
+// imposes dp/dn = 0 at the walls on the stabilisation (dt/rho) L p as well, while the load needs
+// dp/dy = -gamma Q/(M+Q) there: the mismatch leaks pore pressure through the "impermeable" base
+// whatever k is (CASES.md Case 17 showed it). The incremental variant (solver.pressure_incremental)
+// puts the stabilisation on p^{n+1} - p^n only and removes most of the leak; what is left
+// (base p_w 0.97 -> 0.94 of the undrained value from 1 to 3 s at dx = 0.2 m, against 0.81 ->
+// 0.66 non-incremental) is not explained yet.
+std::vector<double> undrained_strip_base_pressure(bool incremental) {
+  test::ThreadCount one(1);
+  test::TempDir dir;
+  const std::string text = fmt::format(R"(
+[geometry]
+dimension = 2
+spacing = 0.2
+[[geometry.block]]
+min = [0.0, 0.0]
+max = [0.6, 4.0]
+[material]
+model = "elastic"
+E = 3.0e7
+nu = 0.2
+density = 1700.0
+[fluid]
+porosity = 0.3
+density = 1000.0
+bulk_modulus = 1.0e8
+conductivity = 0.0
+[solver]
+version = "v3"
+pressure_incremental = {}
+[functions.ramp]
+type = "ramp"
+duration = 0.5
+[body_force]
+gravity = [0.0, -9.81]
+function = "ramp"
+[damping]
+coefficient = 20.0
+[[boundary]]
+name = "left"
+x = [0.0, 0.0]
+velocity = {{ x = 0.0 }}
+[[boundary]]
+name = "right"
+x = [0.6, 0.6]
+velocity = {{ x = 0.0 }}
+[[boundary]]
+name = "base"
+y = [0.0, 0.0]
+velocity = {{ x = 0.0, y = 0.0 }}
+[time]
+end = 3.0
+cfl = 0.5
+)",
+                                       incremental ? "true" : "false");
+  auto setup = test::case_from_string<2>(dir, text);
+  StaggeredSolver<2> solver(setup);
+  const auto& nodes = solver.particles().nodes;
+  std::size_t base = 0;
+  for (std::size_t i = 0; i < static_cast<std::size_t>(nodes.size()); ++i) {
+    if (std::abs(nodes.position[i][0] - 0.2) < 1e-9 && nodes.position[i][1] < 1e-9) base = i;
+  }
+  std::vector<double> out;  // p_w at the base at t = 1, 2, 3 s
+  for (double t : {1.0, 2.0, 3.0}) {
+    while (solver.time() < t - 1e-9) solver.step();
+    out.push_back(solver.node_pore_pressure()[base]);
+  }
+  return out;
+}
+
+TEST(Saturated, IncrementalProjectionReducesTheUndrainedPressureLeakUnderGravity) {
+  const double p_ref = kQ / (kM + kQ) * kRho * 9.81 * 4.0;  // undrained p_w at the base
+  const auto inc = undrained_strip_base_pressure(true);
+  const auto non = undrained_strip_base_pressure(false);  // the METHOD.md §2.4 default
+  for (double p : inc) EXPECT_NEAR(p, p_ref, 0.07 * p_ref);
+  // Over the hold (1 -> 3 s) the incremental variant loses about a fifth of what the
+  // non-incremental one loses (measured: 3.1 % against 14.8 % of the reference).
+  EXPECT_LT(inc[0] - inc[2], 0.25 * (non[0] - non[2]));
+  EXPECT_GT(non[0] - non[2], 0.1 * p_ref);  // the leak of the default, on record
+  RecordProperty("non_incremental_base_pw_over_ref_at_3s", std::to_string(non[2] / p_ref));
+  std::cerr << fmt::format("undrained strip, base p_w / reference at t = 1, 2, 3 s: incremental {:.4f} {:.4f} {:.4f}, "
+                           "non-incremental {:.4f} {:.4f} {:.4f}\n",
+                           inc[0] / p_ref, inc[1] / p_ref, inc[2] / p_ref, non[0] / p_ref, non[1] / p_ref, non[2] / p_ref);
 }
 
 }  // namespace

@@ -1,0 +1,29 @@
+#pragma once
+// Shared by the sample-localisation cases 3 and 16 (CASES.md Cases 3 and 16): the band angle of
+// CASES.md §1.3 from a nodal plastic-strain field.
+#include <vector>
+
+namespace rktsph::validation {
+
+/// The band fitted to the cloud of nodes where eps >= 50 % of its maximum inside the band
+/// region (CASES.md §1.3).
+struct BandFit {
+  double angle = 0.0;    // degrees to the horizontal: the pair's mean arm angle, or the whole cloud's axis
+  double whole = 0.0;    // principal axis of the whole cloud, degrees
+  double upper = 0.0;    // principal axis of the part of the cloud above its centroid, degrees
+  double lower = 0.0;    // ... below its centroid
+  double offset = 0.0;   // distance of the imperfection centre from the nearer arm's axis, m
+  bool pair = false;     // a conjugate pair ("<" or ">") rather than one straight band
+  int particles = 0;     // nodes in the cloud
+  std::vector<char> in_band;  // per node: in the cloud
+};
+
+/// Band of the nodal field `eps` at positions (x, y). The band region is the sample without
+/// the `margin` next to each platen (y = 0 and y = height): the platen corners concentrate
+/// strain by the boundary, not by the band. A conjugate pair is fitted arm by arm, the arms
+/// being the parts of the cloud above and below its centroid; the whole-cloud axis is also
+/// given. (xi, yi) is the imperfection centre.
+BandFit fit_band(const std::vector<double>& x, const std::vector<double>& y, const std::vector<double>& eps,
+                 double height, double margin, double xi, double yi);
+
+}  // namespace rktsph::validation
