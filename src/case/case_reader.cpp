@@ -415,6 +415,10 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     s->require(c.fluid.max_iterations >= 1, "pressure_max_iterations", "must be >= 1");
     c.fluid.deferred_correction = s->boolean("pressure_deferred_correction", true);
     c.fluid.incremental = s->boolean("pressure_incremental", false);
+    const std::string divergence = s->string("pressure_divergence", "nodes");
+    if (divergence == "nodes") c.fluid.divergence_from_stress_points = false;
+    else if (divergence == "stress_points") c.fluid.divergence_from_stress_points = true;
+    else s->fail("pressure_divergence", fmt::format("unknown value '{}' (known: nodes, stress_points)", divergence));
     const std::string scheme = s->string("scheme", "staggered");
     if (scheme == "staggered") c.scheme = Scheme::staggered;
     else if (scheme == "collocated") c.scheme = Scheme::collocated;

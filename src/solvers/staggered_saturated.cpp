@@ -107,14 +107,19 @@ void StaggeredSolver<Dim>::build_saturated() {
   inv_storage_ = fl.inverse_storage();
   PorePressureSolver::Settings s;
   s.inv_q_dt = inv_storage_ / dt_;
-  s.k_eff = fl.permeability() + fl.saturation * dt_ / rho;
+  // The stabilisation time is dt with div v* at the nodes (METHOD.md §2.4) and dt/2 with the
+  // stress points' half-step velocity, which carries (dt/2) grad p / rho in a quasi-static state
+  // (see pressure_step).
+  stabilisation_time_ = fl.divergence_from_stress_points ? 0.5 * dt_ : dt_;
+  if (fl.divergence_from_stress_points) elem_v_skeleton_.assign(static_cast<std::size_t>(disc_.elements.size()) * Dim, 0.0);
+  s.k_eff = fl.permeability() + fl.saturation * stabilisation_time_ / rho;
   s.tolerance = fl.tolerance;
   s.max_iterations = fl.max_iterations;
   s.preconditioner = fl.incomplete_cholesky ? PressurePreconditioner::incomplete_cholesky
                                             : PressurePreconditioner::diagonal;
   s.deferred_correction = fl.deferred_correction;
   if (fl.incremental) {
-    s.incremental = fl.saturation * dt_ / rho;
+    s.incremental = fl.saturation * stabilisation_time_ / rho;
     pw_grad_.assign(nn * static_cast<std::size_t>(Dim), 0.0);
   }
   pressure_ = std::make_unique<PorePressureSolver>(lap.full, lap.symmetric, pw_drained_, s);
@@ -134,13 +139,32 @@ void StaggeredSolver<Dim>::pressure_step(double t_new) {
   const auto* wg = op_nn_.grad.data();
   double* phi = node_phi_.data();
   // RHS_I = p^n_I/(Q* dt) - S_w (div v*)_I; drained nodes take their value at t^{n+1}.
+  //
+  // solver.pressure_divergence = "stress_points": div of the stress points' pressure-free half-
+  // step velocity v~_E = P_EN v^n + (dt/2)(div sigma'/rho + b), gradient back to the nodes, with
+  // the stabilisation S_w (dt/2)/rho in K. In a quasi-static state v~ = v + (dt/2) grad p/rho,
+  // so the two (dt/2) terms cancel as the dt terms of METHOD.md §2.4 do; and when the stress
+  // points are at rest the source is (dt/2) div grad p/rho, cancelled by K, so p_w drains to
+  // zero. With div v* at the nodes it does not where a load jumps (a footing edge): there the
+  // nodes keep an O(dt) velocity in the steady state that no stress point sees (docs/method-
+  // notes.md, "Displacements"), and its divergence feeds a steady Darcy flow (Case 15: 0.2 sigma0
+  // that never drains). Half the stabilisation damps odd-even pressure modes less (Case 16).
+  const bool from_stress_points = !elem_v_skeleton_.empty();
 #pragma omp parallel for schedule(static) if (nn > kParallelMinV3)
   for (Index i = 0; i < nn; ++i) {
     const auto iu = static_cast<std::size_t>(i);
     double div = 0.0;
-    for (Index k = pstart[pat[i]]; k < pstart[pat[i] + 1]; ++k) {
-      const double* v = phi + static_cast<std::size_t>(base[i] + off[k]) * NV;
-      for (int d = 0; d < Dim; ++d) div += wg[k][static_cast<std::size_t>(d)] * v[d];
+    if (from_stress_points) {
+      const auto r = op_ne_.row(i);
+      for (Index k = r.begin; k < r.end; ++k) {
+        const double* v = &elem_v_skeleton_[static_cast<std::size_t>(op_ne_.source(r, k)) * Dim];
+        for (int d = 0; d < Dim; ++d) div += op_ne_.grad[static_cast<std::size_t>(k)][static_cast<std::size_t>(d)] * v[d];
+      }
+    } else {
+      for (Index k = pstart[pat[i]]; k < pstart[pat[i] + 1]; ++k) {
+        const double* v = phi + static_cast<std::size_t>(base[i] + off[k]) * NV;
+        for (int d = 0; d < Dim; ++d) div += wg[k][static_cast<std::size_t>(d)] * v[d];
+      }
     }
     pw_source_[iu] = pw_old_[iu] * inv_q_dt - sw * div;
     if (pw_drained_[iu]) pw_[iu] = pw_value_[iu] * setup_.function_value(pw_function_[iu], t_new);
@@ -178,7 +202,7 @@ void StaggeredSolver<Dim>::pressure_step(double t_new) {
         const double* g = &pw_grad_[static_cast<std::size_t>(base[i] + off[k]) * Dim];
         for (int d = 0; d < Dim; ++d) div += wg[k][static_cast<std::size_t>(d)] * g[d];
       }
-      pw_source_[iu] += sw * dt_ * div;
+      pw_source_[iu] += sw * stabilisation_time_ * div;
     }
   }
   pressure_->solve(pw_source_, pw_old_, pw_);

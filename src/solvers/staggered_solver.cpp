@@ -478,6 +478,11 @@ void StaggeredSolver<Dim>::step_elements(double t) {
       double dv[Dim], dsig[NS];
       flux_rates<Dim>(grad, 1.0 / disc_.elements.density[eu], lambda_[m], shear_[m], dv, dsig);
       if (saturated_) {  // V3 (METHOD.md §5.3): -grad p^n / rho in the element half-step
+        if (!elem_v_skeleton_.empty()) {  // solver.pressure_divergence = "stress_points"
+          for (int i = 0; i < Dim; ++i) {
+            elem_v_skeleton_[eu * Dim + static_cast<std::size_t>(i)] = damped_velocity(bar[i], dv[i] + b[i], cd, tau);
+          }
+        }
         for (Index k = k0; k < k1; ++k) {
           const double pr = pw_[static_cast<std::size_t>(base[e] + off[k])] / disc_.elements.density[eu];
           for (int d = 0; d < Dim; ++d) dv[d] -= wg[k][static_cast<std::size_t>(d)] * pr;

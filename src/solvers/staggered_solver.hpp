@@ -179,6 +179,8 @@ class StaggeredSolver {
   // ---- V3 state (empty in V1)
   bool saturated_ = false;
   std::vector<double> pw_, pw_old_, pw_source_;
+  std::vector<double> elem_v_skeleton_;  // pressure-free half-step velocity per stress point (option)
+  double stabilisation_time_ = 0.0;      // dt (METHOD.md §2.4) or dt/2 (stress-point divergence)
   std::vector<double> pw_grad_;       // incremental projection: grad p^n / rho per node (Dim each)
   std::vector<bool> pw_drained_;
   std::vector<double> pw_value_;      // prescribed pore pressure at drained nodes, Pa

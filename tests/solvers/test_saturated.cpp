@@ -183,6 +183,35 @@ TEST(Saturated, UndrainedLimitGivesTheUndrainedResponse) {
   EXPECT_NEAR(solver.node_phi()[mid * NV + 1], -5.0e3 * kM / (kM + kQ), 0.1 * 5.0e3 * kM / (kM + kQ));
 }
 
+// The same undrained column with the storage equation driven by the stress points' velocity
+// (solver.pressure_divergence = "stress_points", half the stabilisation): stable at k = 0 with
+// the drained skeleton's time step, and the same undrained response.
+TEST(Saturated, StressPointDivergenceKeepsTheUndrainedResponse) {
+  test::ThreadCount one(1);
+  test::TempDir dir;
+  auto setup = test::case_from_string<1>(
+      dir, column(10.0, 0.1, 0.0, "type = \"ramp\"\nduration = 2.0", 3.0, "impermeable = true"),
+      {"solver.pressure_divergence=stress_points"});
+  StaggeredSolver<1> solver(setup);
+  EXPECT_NEAR(solver.dt(), 0.5 * 0.1 / std::sqrt(kM / kRho), 1e-12);
+  const auto& nodes = solver.particles().nodes;
+  std::size_t mid = 0;
+  for (std::size_t i = 0; i < static_cast<std::size_t>(nodes.size()); ++i) {
+    if (std::abs(nodes.position[i][0] - 5.0) < 1e-9) mid = i;
+  }
+  double p_sum = 0.0;
+  long count = 0;
+  while (solver.time() < 3.0 - 1e-9) {
+    solver.step();
+    if (solver.time() >= 2.0) {
+      p_sum += solver.node_pore_pressure()[mid];
+      ++count;
+    }
+  }
+  const double p0 = 5.0e3 * kQ / (kM + kQ);
+  EXPECT_NEAR(p_sum / static_cast<double>(count), p0, 0.01 * p0);
+}
+
 TEST(Saturated, DrainedLimitReducesToV1) {
   test::ThreadCount one(1);
   test::TempDir dir;
