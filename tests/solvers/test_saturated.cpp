@@ -145,71 +145,69 @@ cfl = 0.5
 
 constexpr double kM = 3.0e7 * 0.8 / (1.2 * 0.6), kQ = 1.0e8 / 0.3, kRho = 1700.0;
 
-TEST(Saturated, UndrainedLimitGivesTheUndrainedResponse) {
+// k = 0 and no drained face: the load, a total stress on the (impermeable) top, is carried by
+// the pore pressure p0 = q Q/(M+Q) and the skeleton q M/(M+Q) (CASES.md Case 13). (A drained
+// top with k = 0 is singular: p jumps from p0 to 0 there, and the scheme spreads the jump
+// over a few dx.) Means over 2-3 s (after a 2 s load ramp) remove the free vibration.
+struct UndrainedColumn {
+  double dt = 0.0, wave_speed = 0.0;
+  double p_mid = 0.0, settlement = 0.0, p_top = 0.0, sigma_mid = 0.0;  // p, u: means over 2-3 s
+};
+
+UndrainedColumn run_undrained_column(const std::vector<std::string>& overrides) {
   test::ThreadCount one(1);
   test::TempDir dir;
-  // k = 0 and no drained face: the load, a total stress on the (impermeable) top, is carried by
-  // the pore pressure p0 = q Q/(M+Q) and the skeleton q M/(M+Q) (CASES.md Case 13). (A drained
-  // top with k = 0 is singular: p jumps from p0 to 0 there, and the scheme spreads the jump
-  // over a few dx.)
   auto setup = test::case_from_string<1>(
-      dir, column(10.0, 0.1, 0.0, "type = \"ramp\"\nduration = 2.0", 3.0, "impermeable = true"));
+      dir, column(10.0, 0.1, 0.0, "type = \"ramp\"\nduration = 2.0", 3.0, "impermeable = true"), overrides);
   StaggeredSolver<1> solver(setup);
-  // The time step is the drained skeleton's: C dx / sqrt(M/rho), not the undrained sqrt((M+Q)/rho).
-  EXPECT_NEAR(solver.dt(), 0.5 * 0.1 / std::sqrt(kM / kRho), 1e-12);
-  EXPECT_NEAR(solver.max_wave_speed(), std::sqrt(kM / kRho), 1e-9);
+  UndrainedColumn out;
+  out.dt = solver.dt();
+  out.wave_speed = solver.max_wave_speed();
   const auto& nodes = solver.particles().nodes;
   std::size_t mid = 0, top = 0;
   for (std::size_t i = 0; i < static_cast<std::size_t>(nodes.size()); ++i) {
     if (std::abs(nodes.position[i][0] - 5.0) < 1e-9) mid = i;
     if (std::abs(nodes.position[i][0] - 10.0) < 1e-9) top = i;
   }
-  double p_sum = 0.0, s_sum = 0.0;
-  long count = 0;
-  while (solver.time() < 3.0 - 1e-9) {
-    solver.step();
-    if (solver.time() >= 2.0) {  // time average over 1 s removes the free vibration
-      p_sum += solver.node_pore_pressure()[mid];
-      s_sum += -solver.node_displacement()[top];
-      ++count;
-    }
-  }
-  const double p0 = 5.0e3 * kQ / (kM + kQ), s0 = 5.0e3 * 10.0 / (kM + kQ);
-  EXPECT_NEAR(p_sum / static_cast<double>(count), p0, 0.01 * p0);
-  EXPECT_NEAR(s_sum / static_cast<double>(count), s0, 0.03 * s0);
-  EXPECT_NEAR(solver.node_pore_pressure()[top], p0, 0.05 * p0);
-  // The effective stress carries the rest, q M/(M+Q).
-  constexpr int NV = StaggeredSolver<1>::NV;
-  EXPECT_NEAR(solver.node_phi()[mid * NV + 1], -5.0e3 * kM / (kM + kQ), 0.1 * 5.0e3 * kM / (kM + kQ));
-}
-
-// The same undrained column with the storage equation driven by the stress points' velocity
-// (solver.pressure_divergence = "stress_points", half the stabilisation): stable at k = 0 with
-// the drained skeleton's time step, and the same undrained response.
-TEST(Saturated, StressPointDivergenceKeepsTheUndrainedResponse) {
-  test::ThreadCount one(1);
-  test::TempDir dir;
-  auto setup = test::case_from_string<1>(
-      dir, column(10.0, 0.1, 0.0, "type = \"ramp\"\nduration = 2.0", 3.0, "impermeable = true"),
-      {"solver.pressure_divergence=stress_points"});
-  StaggeredSolver<1> solver(setup);
-  EXPECT_NEAR(solver.dt(), 0.5 * 0.1 / std::sqrt(kM / kRho), 1e-12);
-  const auto& nodes = solver.particles().nodes;
-  std::size_t mid = 0;
-  for (std::size_t i = 0; i < static_cast<std::size_t>(nodes.size()); ++i) {
-    if (std::abs(nodes.position[i][0] - 5.0) < 1e-9) mid = i;
-  }
-  double p_sum = 0.0;
   long count = 0;
   while (solver.time() < 3.0 - 1e-9) {
     solver.step();
     if (solver.time() >= 2.0) {
-      p_sum += solver.node_pore_pressure()[mid];
+      out.p_mid += solver.node_pore_pressure()[mid];
+      out.settlement += -solver.node_displacement()[top];
       ++count;
     }
   }
-  const double p0 = 5.0e3 * kQ / (kM + kQ);
-  EXPECT_NEAR(p_sum / static_cast<double>(count), p0, 0.01 * p0);
+  out.p_mid /= static_cast<double>(count);
+  out.settlement /= static_cast<double>(count);
+  out.p_top = solver.node_pore_pressure()[top];
+  out.sigma_mid = solver.node_phi()[mid * StaggeredSolver<1>::NV + 1];
+  return out;
+}
+
+constexpr double kP0 = 5.0e3 * kQ / (kM + kQ), kS0 = 5.0e3 * 10.0 / (kM + kQ);
+
+TEST(Saturated, UndrainedLimitGivesTheUndrainedResponse) {
+  const UndrainedColumn r = run_undrained_column({});
+  // The time step is the drained skeleton's: C dx / sqrt(M/rho), not the undrained sqrt((M+Q)/rho).
+  EXPECT_NEAR(r.dt, 0.5 * 0.1 / std::sqrt(kM / kRho), 1e-12);
+  EXPECT_NEAR(r.wave_speed, std::sqrt(kM / kRho), 1e-9);
+  EXPECT_NEAR(r.p_mid, kP0, 0.01 * kP0);
+  EXPECT_NEAR(r.settlement, kS0, 0.03 * kS0);
+  EXPECT_NEAR(r.p_top, kP0, 0.05 * kP0);
+  // The effective stress carries the rest, q M/(M+Q).
+  EXPECT_NEAR(r.sigma_mid, -5.0e3 * kM / (kM + kQ), 0.1 * 5.0e3 * kM / (kM + kQ));
+}
+
+// The same column with the storage equation driven by the stress points' velocity
+// (solver.pressure_divergence = "stress_points", half the stabilisation): stable at k = 0 with
+// the drained skeleton's time step, and the same undrained response.
+TEST(Saturated, StressPointDivergenceKeepsTheUndrainedResponse) {
+  const UndrainedColumn r = run_undrained_column({"solver.pressure_divergence=stress_points"});
+  EXPECT_NEAR(r.dt, 0.5 * 0.1 / std::sqrt(kM / kRho), 1e-12);
+  EXPECT_NEAR(r.p_mid, kP0, 0.01 * kP0);
+  EXPECT_NEAR(r.settlement, kS0, 0.03 * kS0);
+  EXPECT_NEAR(r.p_top, kP0, 0.05 * kP0);
 }
 
 TEST(Saturated, DrainedLimitReducesToV1) {
