@@ -129,6 +129,13 @@ TEST(InputErrors, WrongType) {
   expect_error_at(o, line_of(text, "nu = "), "material.nu", {"must be a number", "string"});
 }
 
+TEST(InputErrors, UnknownPressureDivergence) {
+  test::TempDir dir;
+  const std::string text = replace(kBase, "[time]", "[solver]\npressure_divergence = \"elements\"\n[time]");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "pressure_divergence"), "solver.pressure_divergence", {"nodes", "stress_points"});
+}
+
 TEST(InputErrors, WrongTypeOfAnArray) {
   test::TempDir dir;
   const std::string text = replace(kBase, "min = [0.0, 0.0]", "min = 0.0");
