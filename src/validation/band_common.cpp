@@ -5,7 +5,17 @@
 #include <numbers>
 #include <utility>
 
+#include "core/error.hpp"
+
 namespace rktsph::validation {
+
+NodeHistory::NodeHistory(const StaggeredSolver<2>& solver, const std::string& name, const std::string& who)
+    : solver_(solver), stride_(static_cast<std::size_t>(solver.history_stride())) {
+  const auto& names = solver.history_names();
+  const auto it = std::find(names.begin(), names.end(), name);
+  if (it == names.end()) throw SolverError(who + ": the material carries no " + name);
+  index_ = static_cast<std::size_t>(it - names.begin());
+}
 
 namespace {
 

@@ -1,9 +1,28 @@
 #pragma once
 // Shared by the sample-localisation cases 3 and 16 (CASES.md Cases 3 and 16): the band angle of
 // CASES.md §1.3 from a nodal plastic-strain field.
+#include <cstddef>
+#include <string>
 #include <vector>
 
+#include "solvers/staggered_solver.hpp"
+
 namespace rktsph::validation {
+
+/// A nodal history variable by name (e.g. "eps_vp_eq"), read as node_history()[i]; throws
+/// SolverError naming `who` if the materials carry no such variable.
+class NodeHistory {
+ public:
+  NodeHistory(const StaggeredSolver<2>& solver, const std::string& name, const std::string& who);
+  double operator()(std::size_t i) const {
+    const int slot = solver_.history_slot(solver_.particles().nodes.material[i], index_);
+    return solver_.node_history()[i * stride_ + static_cast<std::size_t>(slot)];
+  }
+
+ private:
+  const StaggeredSolver<2>& solver_;
+  std::size_t index_ = 0, stride_ = 0;
+};
 
 /// The band fitted to the cloud of nodes where eps >= 50 % of its maximum inside the band
 /// region (CASES.md §1.3).

@@ -101,15 +101,7 @@ SampleResult run_sample(const std::string& case_file, double dx, double end_stra
   constexpr int NV = StaggeredSolver<2>::NV;
   const auto& nodes = solver.particles().nodes;
   const auto nn = static_cast<std::size_t>(nodes.size());
-  const auto& names = solver.history_names();
-  const auto name_it = std::find(names.begin(), names.end(), "eps_vp_eq");
-  if (name_it == names.end()) throw SolverError("case 3: the material carries no eps_vp_eq");
-  const auto name_index = static_cast<std::size_t>(name_it - names.begin());
-  const auto stride = static_cast<std::size_t>(solver.history_stride());
-  auto eps_of = [&](std::size_t i) {
-    const int sl = solver.history_slot(nodes.material[i], name_index);
-    return solver.node_history()[i * stride + static_cast<std::size_t>(sl)];
-  };
+  const NodeHistory eps_of(solver, "eps_vp_eq", "case 3");
   auto q_of = [&](std::size_t i) { return invariants(to_sym6<2>(&solver.node_phi()[i * NV + 2])).q; };
   std::vector<std::size_t> top;
   double volume = 0.0;

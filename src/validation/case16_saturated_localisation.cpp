@@ -117,15 +117,7 @@ SatRun run_sample(const std::string& case_file, double dx, double k, double end_
   constexpr int NV = StaggeredSolver<2>::NV;
   const auto& nodes = solver.particles().nodes;
   const auto nn = static_cast<std::size_t>(nodes.size());
-  const auto& names = solver.history_names();
-  const auto name_it = std::find(names.begin(), names.end(), "eps_vp_eq");
-  if (name_it == names.end()) throw SolverError("case 16: the material carries no eps_vp_eq");
-  const auto name_index = static_cast<std::size_t>(name_it - names.begin());
-  const auto stride = static_cast<std::size_t>(solver.history_stride());
-  auto eps_of = [&](std::size_t i) {
-    const int sl = solver.history_slot(nodes.material[i], name_index);
-    return solver.node_history()[i * stride + static_cast<std::size_t>(sl)];
-  };
+  const NodeHistory eps_of(solver, "eps_vp_eq", "case 16");
   auto q_of = [&](std::size_t i) { return invariants(to_sym6<2>(&solver.node_phi()[i * NV + 2])).q; };
   double volume = 0.0;
   for (std::size_t i = 0; i < nn; ++i) volume += nodes.volume[i];
