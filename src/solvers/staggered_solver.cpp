@@ -96,6 +96,23 @@ inline void run_sums(const double* src, std::size_t stride, std::size_t len, con
   if (i0 < len) block(len - i0, std::false_type{});
 }
 
+// Interpolation (acc[0]) and gradient (acc[1..Dim]) of the NV-component field `src` at the
+// targets of run r of `op` (step 1 from the nodes, step 2 from the stress points).
+template <int Dim, int NV>
+inline void interpolate_run(const CorrectedOperator<Dim>& op, const double* src, Index r,
+                            double (&acc)[Dim + 1][CorrectedOperator<Dim>::kMaxRun * NV]) {
+  const Index a0 = op.run_start[static_cast<std::size_t>(r)], a1 = op.run_start[static_cast<std::size_t>(r) + 1];
+  const auto p = static_cast<std::size_t>(op.pattern[static_cast<std::size_t>(a0)]);
+  double* sums[Dim + 1];
+  for (int q = 0; q <= Dim; ++q) sums[q] = acc[q];
+  run_sums<Dim + 1, 16>(src + static_cast<std::size_t>(op.base[static_cast<std::size_t>(a0)]) * NV, NV,
+                        static_cast<std::size_t>(a1 - a0) * NV, op.offset.data(), op.pattern_start[p],
+                        op.pattern_start[p + 1], [&](Index k, double* w) {
+                          w[0] = op.interp[static_cast<std::size_t>(k)];
+                          for (int d = 0; d < Dim; ++d) w[1 + d] = op.grad[static_cast<std::size_t>(k)][static_cast<std::size_t>(d)];
+                        }, sums);
+}
+
 }  // namespace
 
 template <int Dim>
@@ -458,13 +475,7 @@ void StaggeredSolver<Dim>::step_elements(double t) {
     double acc[Dim + 1][kRunLen];
     const Index e0 = runs[r], e1 = runs[r + 1];
     const Index k0 = pstart[pat[e0]], k1 = pstart[pat[e0] + 1];
-    double* sums[Dim + 1];
-    for (int q = 0; q <= Dim; ++q) sums[q] = acc[q];
-    run_sums<Dim + 1, 16>(nphi + static_cast<std::size_t>(base[e0]) * NV, NV, static_cast<std::size_t>(e1 - e0) * NV,
-                          off, k0, k1, [&](Index k, double* w) {
-                            w[0] = wi[k];
-                            for (int d = 0; d < Dim; ++d) w[1 + d] = wg[k][static_cast<std::size_t>(d)];
-                          }, sums);
+    interpolate_run<Dim, NV>(op_en_, nphi, r, acc);
     for (Index e = e0; e < e1; ++e) {
       const auto slot0 = static_cast<std::size_t>(e - e0) * NV;
       double bar[NV];
@@ -520,40 +531,29 @@ void StaggeredSolver<Dim>::step_nodes(double t) {
   const double cd = damping_at(t);
   const double t_half = t + 0.5 * dt_;
   const Index nn = disc_.nodes.size();
-  const Index* base = op_ne_.base.data();
-  const Index* pat = op_ne_.pattern.data();
-  const Index* pstart = op_ne_.pattern_start.data();
-  const Index* off = op_ne_.offset.data();
-  const double* wi = op_ne_.interp.data();
-  const auto* wg = op_ne_.grad.data();
   const double* ephi = elem_phi_.data();
   constexpr std::size_t kRunLen = CorrectedOperator<Dim>::kMaxRun * NV;
   const Index* runs = op_ne_.run_start.data();
   const Index nruns = op_ne_.runs();
 #pragma omp parallel for schedule(static) if (nn > kParallelMin)
   for (Index r = 0; r < nruns; ++r) {
-    // Gradient of the state (outputs 0..Dim-1) and interpolation (output Dim) at the run's nodes.
+    // Interpolation (slot 0: the velocity for the displacement) and gradient of the stress
+    // points' state at the run's nodes.
     double acc[Dim + 1][kRunLen];
     const Index i0 = runs[r], i1 = runs[r + 1];
-    double* sums[Dim + 1];
-    for (int q = 0; q <= Dim; ++q) sums[q] = acc[q];
-    run_sums<Dim + 1, 16>(ephi + static_cast<std::size_t>(base[i0]) * NV, NV, static_cast<std::size_t>(i1 - i0) * NV, off,
-                          pstart[pat[i0]], pstart[pat[i0] + 1], [&](Index k, double* w) {
-                            for (int d = 0; d < Dim; ++d) w[d] = wg[k][static_cast<std::size_t>(d)];
-                            w[Dim] = wi[k];
-                          }, sums);
+    interpolate_run<Dim, NV>(op_ne_, ephi, r, acc);
     for (Index i = i0; i < i1; ++i) {
       const auto slot = static_cast<std::size_t>(i - i0) * NV;
       double grad[Dim][NV];
       for (int c = 0; c < NV; ++c) {
-        for (int d = 0; d < Dim; ++d) grad[d][c] = acc[d][slot + static_cast<std::size_t>(c)];
+        for (int d = 0; d < Dim; ++d) grad[d][c] = acc[1 + d][slot + static_cast<std::size_t>(c)];
       }
       const auto iu = static_cast<std::size_t>(i);
       // The material velocity at t^{n+1/2} for the displacement: the stress points' velocity,
       // interpolated back. Not the nodal v, which in a steady state keeps an O(dt) component the
       // stress points never see (it balances the filter against the residual nodal force: see
       // docs/method-notes.md, "Displacements"), and would make u drift.
-      for (int d = 0; d < Dim; ++d) v_half_[iu * Dim + static_cast<std::size_t>(d)] = acc[Dim][slot + static_cast<std::size_t>(d)];
+      for (int d = 0; d < Dim; ++d) v_half_[iu * Dim + static_cast<std::size_t>(d)] = acc[0][slot + static_cast<std::size_t>(d)];
       for (Index q = constraint_row_[iu]; q < constraint_row_[iu + 1]; ++q) {
         const NodalConstraint& con = constraints_[static_cast<std::size_t>(q)];
         if (con.component < Dim) v_half_[iu * Dim + static_cast<std::size_t>(con.component)] = constraint_value(iu, con, t_half);
