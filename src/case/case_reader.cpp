@@ -419,6 +419,9 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     if (divergence == "nodes") c.fluid.divergence_from_stress_points = false;
     else if (divergence == "stress_points") c.fluid.divergence_from_stress_points = true;
     else s->fail("pressure_divergence", fmt::format("unknown value '{}' (known: nodes, stress_points)", divergence));
+    c.fluid.filter = s->number("pressure_filter", 0.0);
+    s->require(c.fluid.filter >= 0.0 && c.fluid.filter <= 10.0, "pressure_filter",
+               fmt::format("must lie in [0, 10] (a multiple of S_w dt/rho), got {}", c.fluid.filter));
     const std::string scheme = s->string("scheme", "staggered");
     if (scheme == "staggered") c.scheme = Scheme::staggered;
     else if (scheme == "collocated") c.scheme = Scheme::collocated;

@@ -66,6 +66,9 @@ struct FluidSpec {
   /// points' pressure-free half-step velocity, with the stabilisation S_w (dt/2)/rho (source-free
   /// when the stress points are at rest; see StaggeredSolver::pressure_step).
   bool divergence_from_stress_points = false;
+  /// solver.pressure_filter: coefficient of the linear-exact pressure filter, in units of the
+  /// fractional-step stabilisation S_w dt/rho (0 = none; see StaggeredSolver::build_saturated).
+  double filter = 0.0;
   double initial_pore_pressure = 0.0;    // Pa, uniform
   /// 1/Q* = S_w n / K_f + (1 - n)/K_s (METHOD.md §1.4), 1/Pa
   double inverse_storage() const {

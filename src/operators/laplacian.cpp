@@ -113,4 +113,41 @@ template NodeLaplacian<2> build_node_laplacian<2>(const ParticleSet<2>&, const C
                                                   const std::vector<std::uint8_t>&, const std::vector<MirrorPlane>&,
                                                   const std::vector<std::uint8_t>&);
 
+template <int Dim>
+Eigen::SparseMatrix<double, Eigen::RowMajor> build_filter_gradient_part(
+    const Eigen::SparseMatrix<double, Eigen::RowMajor>& symmetric, const std::vector<Vec<Dim>>& position,
+    const std::array<Eigen::SparseMatrix<double, Eigen::RowMajor>, Dim>& gradient) {
+  using Sparse = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+  using Triplet = Eigen::Triplet<double>;
+  const auto n = symmetric.rows();
+  // T_d: (T_d g)_I = sum_J S_IJ 1/2 (g_I + g_J) (x_J - x_I)_d.
+  Sparse out(n, n);
+  for (int d = 0; d < Dim; ++d) {
+    std::vector<Triplet> t;
+    for (Eigen::Index i = 0; i < n; ++i) {
+      double diag = 0.0;
+      for (Sparse::InnerIterator it(symmetric, i); it; ++it) {
+        if (it.col() == i) continue;
+        const double w = 0.5 * it.value() *
+                         (position[static_cast<std::size_t>(it.col())][d] - position[static_cast<std::size_t>(i)][d]);
+        t.emplace_back(i, it.col(), w);
+        diag += w;
+      }
+      t.emplace_back(i, i, diag);
+    }
+    Sparse T(n, n);
+    T.setFromTriplets(t.begin(), t.end());
+    out += Sparse(T * gradient[static_cast<std::size_t>(d)]);
+  }
+  out.prune(0.0, 1e-14);
+  return out;
+}
+
+template Eigen::SparseMatrix<double, Eigen::RowMajor> build_filter_gradient_part<1>(
+    const Eigen::SparseMatrix<double, Eigen::RowMajor>&, const std::vector<Vec<1>>&,
+    const std::array<Eigen::SparseMatrix<double, Eigen::RowMajor>, 1>&);
+template Eigen::SparseMatrix<double, Eigen::RowMajor> build_filter_gradient_part<2>(
+    const Eigen::SparseMatrix<double, Eigen::RowMajor>&, const std::vector<Vec<2>>&,
+    const std::array<Eigen::SparseMatrix<double, Eigen::RowMajor>, 2>&);
+
 }  // namespace rktsph

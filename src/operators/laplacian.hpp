@@ -25,6 +25,7 @@
 // the Brookshaw sum with symmetrised weights. S is symmetric negative semi-definite (a weighted
 // graph Laplacian). The difference L - S is applied to the previous pressure (deferred
 // correction) by the pore-pressure solver.
+#include <array>
 #include <vector>
 
 #include <Eigen/SparseCore>
@@ -70,5 +71,20 @@ NodeLaplacian<Dim> build_node_laplacian(const ParticleSet<Dim>& nodes,
                                         const std::vector<std::uint8_t>& wall_axes = {},
                                         const std::vector<MirrorPlane>& mirrors = {},
                                         const std::vector<std::uint8_t>& mirror_mask = {});
+
+/// The explicit half of the linear-exact pressure filter (the delta-SPH diffusion of Antuono et
+/// al. 2010, written on the symmetric Brookshaw weights S_IJ of `symmetric`):
+///
+///   F p_I = sum_J S_IJ psi_IJ,   psi_IJ = (p_J - p_I) - 1/2 (grad p_I + grad p_J) . (x_J - x_I),
+///
+/// = (S p)_I - (T G p)_I. Returns T G, given the corrected gradient G as one sparse matrix per
+/// axis (`gradient[d]`, rows and columns the nodes). psi_IJ vanishes for linear fields wherever G
+/// is exact (every row of a CSPM gradient, walls included) and for quadratic fields wherever G is
+/// exact for them (the interior of a lattice), so F acts on odd-even modes (G p ~ 0, psi_IJ =
+/// p_J - p_I) and not on the smooth gradient a load imposes at a wall.
+template <int Dim>
+Eigen::SparseMatrix<double, Eigen::RowMajor> build_filter_gradient_part(
+    const Eigen::SparseMatrix<double, Eigen::RowMajor>& symmetric, const std::vector<Vec<Dim>>& position,
+    const std::array<Eigen::SparseMatrix<double, Eigen::RowMajor>, Dim>& gradient);
 
 }  // namespace rktsph

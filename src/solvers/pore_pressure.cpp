@@ -20,9 +20,10 @@ namespace rktsph {
 // solve was measured on 2 busy cores.)
 struct PorePressureSolver::Impl {
   Sparse K;        // free-free block of I/(Q dt) - k_eff S
-  Sparse S_fd;     // free rows, drained columns of S (Dirichlet values to the right-hand side)
+  Sparse S_fd;     // free rows, drained columns of k_eff S (+ tau S_f) (Dirichlet values to the right-hand side)
   Sparse D;        // free rows of L - S, all columns (deferred correction)
   Sparse S_f;      // free rows of L (S without the deferred correction), all columns (incremental projection)
+  Sparse F;        // free rows of tau (T G)_f, all columns (explicit half of the pressure filter)
   Eigen::ConjugateGradient<Sparse, Eigen::Lower, Eigen::DiagonalPreconditioner<double>> cg_diag;
   Eigen::ConjugateGradient<Sparse, Eigen::Lower, Eigen::IncompleteCholesky<double>> cg_ic;
   Eigen::VectorXd rhs, x, p_all, p_d;
@@ -33,8 +34,13 @@ PorePressureSolver::~PorePressureSolver() = default;
 const PorePressureSolver::Sparse& PorePressureSolver::matrix() const { return impl_->K; }
 
 PorePressureSolver::PorePressureSolver(const Sparse& full, const Sparse& symmetric,
-                                       const std::vector<bool>& dirichlet, const Settings& settings)
+                                       const std::vector<bool>& dirichlet, const Settings& settings,
+                                       const Sparse* filter_symmetric, const Sparse* filter_explicit)
     : impl_(std::make_unique<Impl>()), settings_(settings) {
+  const bool filtered = settings.filter > 0.0;
+  if (filtered && (filter_symmetric == nullptr || filter_explicit == nullptr)) {
+    throw SolverError("pore pressure: a filter coefficient was given without the filter operators");
+  }
   const auto n = static_cast<std::size_t>(full.rows());
   index_.assign(n, -1);
   std::vector<Index> drained_index(n, -1);
@@ -49,14 +55,27 @@ PorePressureSolver::PorePressureSolver(const Sparse& full, const Sparse& symmetr
   }
   const auto nf = static_cast<Eigen::Index>(free_.size());
   using Triplet = Eigen::Triplet<double>;
-  std::vector<Triplet> k, sfd, d, sf;
+  std::vector<Triplet> k, sfd, d, sf, f;
   for (Eigen::Index r = 0; r < nf; ++r) {
     const auto i = static_cast<Eigen::Index>(free_[static_cast<std::size_t>(r)]);
     k.emplace_back(r, r, settings.inv_q_dt);
+    if (filtered) {
+      // tau S_f in K (its drained columns to the right-hand side), tau (T G)_f p^n on the
+      // right-hand side.
+      for (Sparse::InnerIterator it(*filter_symmetric, i); it; ++it) {
+        const auto j = static_cast<std::size_t>(it.col());
+        if (dirichlet[j]) {
+          sfd.emplace_back(r, drained_index[j], settings.filter * it.value());
+        } else {
+          k.emplace_back(r, index_[j], -settings.filter * it.value());
+        }
+      }
+      for (Sparse::InnerIterator it(*filter_explicit, i); it; ++it) f.emplace_back(r, it.col(), settings.filter * it.value());
+    }
     for (Sparse::InnerIterator it(symmetric, i); it; ++it) {
       const auto j = static_cast<std::size_t>(it.col());
       if (dirichlet[j]) {
-        sfd.emplace_back(r, drained_index[j], it.value());
+        sfd.emplace_back(r, drained_index[j], settings.k_eff * it.value());
       } else {
         k.emplace_back(r, index_[j], -settings.k_eff * it.value());
       }
@@ -77,6 +96,8 @@ PorePressureSolver::PorePressureSolver(const Sparse& full, const Sparse& symmetr
   impl_->D.prune(0.0, 1e-14);
   impl_->S_f.resize(nf, static_cast<Eigen::Index>(n));
   impl_->S_f.setFromTriplets(sf.begin(), sf.end());
+  impl_->F.resize(nf, static_cast<Eigen::Index>(n));
+  impl_->F.setFromTriplets(f.begin(), f.end());
   impl_->rhs.resize(nf);
   impl_->x.resize(nf);
   impl_->p_all.resize(static_cast<Eigen::Index>(n));
@@ -114,10 +135,11 @@ void PorePressureSolver::solve(const std::vector<double>& source, const std::vec
     m.rhs[r] = source[i];
     m.x[r] = p_old[i];
   }
-  // Drained values at t^{n+1}: -K_fd p_d = k_eff S_fd p_d.
-  if (nd > 0) m.rhs.noalias() += settings_.k_eff * (m.S_fd * m.p_d);
+  // Drained values at t^{n+1}: -K_fd p_d = S_fd p_d.
+  if (nd > 0) m.rhs.noalias() += m.S_fd * m.p_d;
   if (settings_.deferred_correction) m.rhs.noalias() += settings_.k_eff * (m.D * m.p_all);
   if (settings_.incremental > 0.0) m.rhs.noalias() -= settings_.incremental * (m.S_f * m.p_all);
+  if (settings_.filter > 0.0) m.rhs.noalias() -= m.F * m.p_all;
   int iterations = 0;
   double error = 0.0;
   bool ok = false;

@@ -48,11 +48,16 @@ class PorePressureSolver {
     /// the right-hand side, and the caller adds S_w dt div(grad p^n / rho) to `source`, so that
     /// the stabilisation acts on p^{n+1} - p^n only. 0 = non-incremental (METHOD.md §2.4).
     double incremental = 0.0;
+    /// Coefficient tau (m^3 s/kg) of the linear-exact pressure filter tau (S_f p^{n+1} - (T G)_f
+    /// p^n) (operators/laplacian.hpp, build_filter_gradient_part); 0 = none. Needs set_filter().
+    double filter = 0.0;
   };
 
   /// `full` and `symmetric` are L and S (1/m^2); `dirichlet[I]` is true at drained nodes.
+  /// With `settings.filter` > 0, `filter_symmetric` and `filter_explicit` are S_f and (T G)_f.
   PorePressureSolver(const Sparse& full, const Sparse& symmetric, const std::vector<bool>& dirichlet,
-                     const Settings& settings);
+                     const Settings& settings, const Sparse* filter_symmetric = nullptr,
+                     const Sparse* filter_explicit = nullptr);
   ~PorePressureSolver();
   PorePressureSolver(const PorePressureSolver&) = delete;
   PorePressureSolver& operator=(const PorePressureSolver&) = delete;

@@ -5,6 +5,7 @@
 // K p^{n+1} = RHS (solvers/pore_pressure.hpp) and the velocity correction
 // v^{n+1} = v* - (dt/rho) grad p^{n+1}.
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <limits>
 #include <cmath>
@@ -122,7 +123,32 @@ void StaggeredSolver<Dim>::build_saturated() {
     s.incremental = fl.saturation * stabilisation_time_ / rho;
     pw_grad_.assign(nn * static_cast<std::size_t>(Dim), 0.0);
   }
-  pressure_ = std::make_unique<PorePressureSolver>(lap.full, lap.symmetric, pw_drained_, s);
+  if (fl.filter > 0.0) {
+    // Linear-exact pressure filter (solver.pressure_filter, operators/laplacian.hpp): tau (S_f p -
+    // T G p) on the plain node set (no wall mirrors: psi_IJ pairs real nodes), G the corrected
+    // node gradient of the velocity correction. It damps odd-even pressure modes, which the
+    // incremental projection leaves undamped, without acting on the linear (and, inside, the
+    // quadratic) pressure fields that loads impose at impermeable walls.
+    s.filter = fl.filter * fl.saturation * stabilisation_time_ / rho;
+    std::array<PorePressureSolver::Sparse, Dim> grad;
+    for (int d = 0; d < Dim; ++d) {
+      std::vector<Eigen::Triplet<double>> t;
+      for (Index i = 0; i < static_cast<Index>(nn); ++i) {
+        const auto r = op_nn_.row(i);
+        for (Index k = r.begin; k < r.end; ++k) {
+          t.emplace_back(static_cast<int>(i), static_cast<int>(op_nn_.source(r, k)),
+                         op_nn_.grad[static_cast<std::size_t>(k)][static_cast<std::size_t>(d)]);
+        }
+      }
+      grad[static_cast<std::size_t>(d)].resize(static_cast<Eigen::Index>(nn), static_cast<Eigen::Index>(nn));
+      grad[static_cast<std::size_t>(d)].setFromTriplets(t.begin(), t.end());
+    }
+    const NodeLaplacian<Dim> plain = build_node_laplacian<Dim>(disc_.nodes, kernel_);
+    const PorePressureSolver::Sparse tg = build_filter_gradient_part<Dim>(plain.symmetric, disc_.nodes.position, grad);
+    pressure_ = std::make_unique<PorePressureSolver>(lap.full, lap.symmetric, pw_drained_, s, &plain.symmetric, &tg);
+  } else {
+    pressure_ = std::make_unique<PorePressureSolver>(lap.full, lap.symmetric, pw_drained_, s);
+  }
 }
 
 template <int Dim>

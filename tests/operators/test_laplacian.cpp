@@ -2,13 +2,17 @@
 // irregular and truncated particle sets (edges and corners included), within 1 % for a
 // quadratic field in the interior, symmetric part symmetric with zero row sums, and the
 // impermeable-wall rows reproduce the even extension of a field with zero normal derivative.
+// The linear-exact pressure filter S - T G vanishes for linear fields everywhere and for
+// quadratic fields inside, and acts fully on the odd-even (checkerboard) mode.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <random>
 
 #include "core/kernel.hpp"
 #include "geometry/particles.hpp"
+#include "operators/corrected_operator.hpp"
 #include "operators/laplacian.hpp"
 
 namespace rktsph {
@@ -161,6 +165,68 @@ TEST(Laplacian, MirrorWallsRestoreTheFullSupportIn2D) {
   // The symmetric part stays symmetric with the images.
   const Eigen::SparseMatrix<double> S = lap.symmetric;
   EXPECT_LT((S - Eigen::SparseMatrix<double>(S.transpose())).norm(), 1e-12 * S.norm());
+}
+
+// The pressure filter's two halves S and T G, with G the corrected node gradient as the solver
+// builds it (StaggeredSolver::build_saturated).
+struct Filter {
+  Eigen::SparseMatrix<double, Eigen::RowMajor> S, TG;
+};
+Filter build_filter(const ParticleSet<2>& s, const CubicSplineKernel<2>& kernel) {
+  const auto op = build_corrected_operator<2>(s.position, s, kernel);
+  std::array<Eigen::SparseMatrix<double, Eigen::RowMajor>, 2> grad;
+  for (int d = 0; d < 2; ++d) {
+    std::vector<Eigen::Triplet<double>> t;
+    for (Index i = 0; i < s.size(); ++i) {
+      const auto r = op.row(i);
+      for (Index k = r.begin; k < r.end; ++k) {
+        t.emplace_back(static_cast<int>(i), static_cast<int>(op.source(r, k)), op.grad[static_cast<std::size_t>(k)][static_cast<std::size_t>(d)]);
+      }
+    }
+    grad[static_cast<std::size_t>(d)].resize(s.size(), s.size());
+    grad[static_cast<std::size_t>(d)].setFromTriplets(t.begin(), t.end());
+  }
+  const auto lap = build_node_laplacian<2>(s, kernel);
+  return {lap.symmetric, build_filter_gradient_part<2>(lap.symmetric, s.position, grad)};
+}
+
+TEST(PressureFilter, VanishesForLinearFieldsOnJitteredAndTruncatedSets) {
+  for (double jitter : {0.0, 0.2}) {
+    const double dx = 0.1;
+    const auto s = lattice2(10, 10, dx, jitter);
+    const auto f = build_filter(s, CubicSplineKernel<2>(1.2 * dx));
+    const Eigen::VectorXd p = sample(s, linear);
+    // Edges and corners included: a wall carrying a linear pressure is not drained by it.
+    EXPECT_LT(((f.S - f.TG) * p).cwiseAbs().maxCoeff(), 1e-9 * 5.0 / (dx * dx)) << "jitter " << jitter;
+  }
+}
+
+TEST(PressureFilter, VanishesForQuadraticFieldsInsideAndDampsTheCheckerboard) {
+  const double dx = 0.1;
+  const auto s = lattice2(14, 14, dx, 0.0);
+  const CubicSplineKernel<2> kernel(1.2 * dx);
+  const auto f = build_filter(s, kernel);
+  const Eigen::VectorXd q = (f.S - f.TG) * sample(s, quadratic);  // its Laplacian is 4
+  Eigen::VectorXd checker(s.size());
+  for (Index i = 0; i < s.size(); ++i) {
+    const Vec<2>& x = s.position[static_cast<std::size_t>(i)];
+    checker[i] = (std::lround(x[0] / dx) + std::lround(x[1] / dx)) % 2 == 0 ? 1.0 : -1.0;
+  }
+  const Eigen::VectorXd c = (f.S - f.TG) * checker;
+  const Eigen::VectorXd cs = f.S * checker;
+  double worst_quadratic = 0.0, weakest_damping = 1e300;
+  for (Index i = 0; i < s.size(); ++i) {
+    const Vec<2>& x = s.position[static_cast<std::size_t>(i)];
+    const double margin = 4.0 * kernel.h() + 0.5 * dx;  // G and then S see full supports
+    if (x[0] < margin || x[1] < margin || x[0] > 1.4 - margin || x[1] > 1.4 - margin) continue;
+    worst_quadratic = std::max(worst_quadratic, std::abs(q[i]) / 4.0);
+    // On the checkerboard the corrected gradient vanishes, so the filter is the Brookshaw
+    // Laplacian S itself, pulling each node towards its neighbours' mean (sign opposite to p).
+    EXPECT_NEAR(c[i], cs[i], 1e-9 * std::abs(cs[i]));
+    weakest_damping = std::min(weakest_damping, -c[i] * checker[i] * dx * dx);
+  }
+  EXPECT_LT(worst_quadratic, 1e-9);  // exact: psi_IJ = 0 for a quadratic where G is exact
+  EXPECT_GT(weakest_damping, 1.0);   // |F p| >~ |p| / dx^2 on the odd-even mode
 }
 
 }  // namespace
