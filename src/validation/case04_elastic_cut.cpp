@@ -339,7 +339,8 @@ CaseReport validate_case04(const Options& opt, const std::string& dir) {
     std::string note;
     if (run_plot_script("plot_case04.py", dir, note)) {
       for (const char* p : {"case04/a_stress_profiles.png", "case04/a_sections.png", "case04/a_deformed.png",
-                            "case04/b_base_stress.png", "case04/b_top_uy.png", "case04/b_face_ux.png"}) {
+                            "case04/b_base_stress.png", "case04/b_top_uy.png", "case04/b_face_ux.png",
+                            "case04/a_face_residual.png"}) {
         rep.plots.push_back(p);
       }
     } else {
