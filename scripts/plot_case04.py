@@ -139,3 +139,6 @@ def main(d):
 
 if __name__ == "__main__":
     main(sys.argv[1])
+    import toe_scaling  # noqa: E402  (scripts/ is on the path: this script's folder)
+
+    toe_scaling.plot(sys.argv[1])  # a_face_residual.png: the face residual against the toe singularity

@@ -176,14 +176,20 @@ CutRun run_cut(const std::string& file, const std::vector<std::string>& override
     }
     // Extrapolation to the boundary at distance (boundary - outer column) = W - xmax.
     const double fx = (r.width - xmax) / r.dx, fy = (r.height - ymax) / r.dx;
-    for (const auto& [row, a] : face1) {
+    double sum2 = 0.0;
+    for (const auto& [row, a] : face1) {  // std::map: rows in increasing y
       const auto b = face2.find(row);
       if (b == face2.end()) continue;
-      const double res = std::max(std::abs(a.first + fx * (a.first - b->second.first)),
-                                  std::abs(a.second + fx * (a.second - b->second.second)));
+      const double sn = a.first + fx * (a.first - b->second.first), st = a.second + fx * (a.second - b->second.second);
+      const double res = std::max(std::abs(sn), std::abs(st));
+      const double y = 0.5 * static_cast<double>(row) * r.dx;
       r.face_residual = std::max(r.face_residual, res);
-      if (0.5 * static_cast<double>(row) * r.dx >= 0.1 * r.height) r.face_residual_above_toe = std::max(r.face_residual_above_toe, res);
+      if (y >= 0.1 * r.height) r.face_residual_above_toe = std::max(r.face_residual_above_toe, res);
+      if (y >= 2.0 * r.dx - 1e-9 * r.dx) r.face_residual_beyond_2dx = std::max(r.face_residual_beyond_2dx, res);
+      r.face_rows.push_back({y, sn, st});
+      sum2 += sn * sn + st * st;
     }
+    if (!r.face_rows.empty()) r.face_residual_rms = std::sqrt(sum2 / static_cast<double>(r.face_rows.size()));
     for (const auto& [col, a] : top1) {
       const auto b = top2.find(col);
       if (b == top2.end()) continue;

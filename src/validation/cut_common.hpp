@@ -62,6 +62,19 @@ struct CutRun {
   double face_residual = 0.0, top_residual = 0.0;
   /// The face residual over the rows y >= 0.1 H only (away from the toe corner), Pa.
   double face_residual_above_toe = 0.0;
+  /// The face residual over the rows y >= 2 dx (all but the first two stress-point rows), Pa.
+  /// A zone of fixed size in cells, not in metres: next to a singular corner it still grows
+  /// as dx^(lambda - 1) (scripts/williams_corner.py), only more weakly than the toe row.
+  double face_residual_beyond_2dx = 0.0;
+  /// RMS (L2) face residual: sqrt(mean over the stress-point rows of s_n^2 + s_t^2), Pa. Finite
+  /// under a corner singularity r^(lambda - 1) with lambda > 1/2, where the maximum is not.
+  double face_residual_rms = 0.0;
+  /// Per row of stress points next to the face: its height y and the extrapolated face
+  /// tractions s_n = sigma_xx, s_t = sigma_xy (Pa), sorted by y (the first is the toe row).
+  struct FaceRow {
+    double y = 0.0, sn = 0.0, st = 0.0;
+  };
+  std::vector<FaceRow> face_rows;
   Classification classification;
 };
 
