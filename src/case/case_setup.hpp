@@ -61,14 +61,14 @@ struct FluidSpec {
   bool deferred_correction = true;       // Schwaiger correction on the right-hand side
   /// Incremental pressure projection (METHOD.md §2.4 "Incremental variant"): the stabilisation
   /// (S_w dt/rho) L acts on p^{n+1} - p^n instead of p^{n+1}.
-  bool incremental = false;
+  bool incremental = true;
   /// solver.pressure_divergence = "stress_points": the storage equation takes div of the stress
   /// points' pressure-free half-step velocity, with the stabilisation S_w (dt/2)/rho (source-free
   /// when the stress points are at rest; see StaggeredSolver::pressure_step).
   bool divergence_from_stress_points = false;
   /// solver.pressure_filter: coefficient of the linear-exact pressure filter, in units of the
   /// fractional-step stabilisation S_w dt/rho (0 = none; see StaggeredSolver::build_saturated).
-  double filter = 0.0;
+  double filter = 0.5;
   double initial_pore_pressure = 0.0;    // Pa, uniform
   /// 1/Q* = S_w n / K_f + (1 - n)/K_s (METHOD.md §1.4), 1/Pa
   double inverse_storage() const {

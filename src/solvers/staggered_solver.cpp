@@ -743,6 +743,18 @@ void StaggeredSolver<Dim>::finish_step() {
   const double damping_power = cd * total[Dim];
   external_work_ += 0.5 * dt_ * (last_power_ + power);
   damping_loss_ += 0.5 * dt_ * (last_damping_power_ + damping_power);
+  // Growth guard: the kinetic energy of a stable run cannot exceed the work done on the body
+  // plus its initial energy (the materials only dissipate). An unstable mode grows v^2 faster
+  // than the boundary power (~ v) feeds the work, so it trips this long before the values
+  // overflow; the factor leaves room for the scheme's own energy error.
+  const double budget = std::abs(external_work_) + initial_energy_;
+  if (kinetic > kEnergyGrowthLimit * budget && steps_ > 0) {
+    throw SolverError(fmt::format(
+        "the kinetic energy ({:.3g} J) exceeds {:g} times the work done on the body plus its initial energy "
+        "({:.3g} J) at step {} (t = {:.6g} s): the run is unstable; reduce the time step (time.cfl = {:.3g}) or check "
+        "the loads, the boundary conditions and the solver options",
+        kinetic, kEnergyGrowthLimit, budget, steps_ + 1, t_new, cfl_));
+  }
   last_power_ = power;
   last_damping_power_ = damping_power;
 }
@@ -750,6 +762,12 @@ void StaggeredSolver<Dim>::finish_step() {
 template <int Dim>
 void StaggeredSolver<Dim>::step() {
   const double t = time_;
+  if (steps_ == 0) {
+    // The energy the body starts the run with, for the growth guard of finish_step (taken here,
+    // not at construction, so that a state set by the caller counts).
+    const EnergyBalance e0 = energy();
+    initial_energy_ = e0.kinetic + std::abs(e0.strain);
+  }
   step_elements(t);
   step_nodes(t);
   apply_constraints(t + dt_);

@@ -173,6 +173,8 @@ class StaggeredSolver {
   // energy accounting
   double external_work_ = 0.0, damping_loss_ = 0.0, initial_strain_ = 0.0;
   double last_power_ = 0.0, last_damping_power_ = 0.0;
+  double initial_energy_ = 0.0;  // kinetic + strain (+ fluid storage) at the first step
+  static constexpr double kEnergyGrowthLimit = 100.0;  // see finish_step
   double kinetic_peak_ = 0.0, damping_off_time_ = std::numeric_limits<double>::infinity();
   double kinetic_below_since_ = -1.0;  // time since when the kinetic energy is below the ratio, -1 = not
 

@@ -136,6 +136,21 @@ TEST(InputErrors, UnknownPressureDivergence) {
   expect_error_at(o, line_of(text, "pressure_divergence"), "solver.pressure_divergence", {"nodes", "stress_points"});
 }
 
+TEST(InputErrors, IncrementalProjectionWithStressPointDivergence) {
+  test::TempDir dir;
+  const std::string text = replace(kBase, "[time]",
+                                   "[solver]\npressure_divergence = \"stress_points\"\npressure_incremental = true\n[time]");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "pressure_incremental"), "solver.pressure_incremental", {"unstable"});
+}
+
+TEST(InputErrors, PressureFilterOutOfRange) {
+  test::TempDir dir;
+  const std::string text = replace(kBase, "[time]", "[solver]\npressure_filter = -1.0\n[time]");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "pressure_filter"), "solver.pressure_filter", {"[0, 10]"});
+}
+
 TEST(InputErrors, WrongTypeOfAnArray) {
   test::TempDir dir;
   const std::string text = replace(kBase, "min = [0.0, 0.0]", "min = 0.0");

@@ -5,7 +5,10 @@
 // reduces to the V1 solver.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <string>
+#include <utility>
 #include <iostream>
 #include <random>
 
@@ -13,6 +16,7 @@
 #include <fmt/format.h>
 
 #include "../support/test_util.hpp"
+#include "core/error.hpp"
 #include "core/kernel.hpp"
 #include "operators/laplacian.hpp"
 #include "solvers/pore_pressure.hpp"
@@ -497,6 +501,79 @@ TEST(Saturated, PressureFilterDampsTheCheckerboardThatTheIncrementalProjectionKe
   EXPECT_LT(projection, 0.01);
   std::cerr << fmt::format("checkerboard left after 20 steps: incremental {:.3g}, incremental + filter {:.3g}, "
                            "non-incremental {:.3g}\n", incremental, filtered, projection);
+}
+
+// The known V3 instability (docs/VALIDATION.md, Case 16): impermeable faces carrying a total
+// stress, undrained Courant number C c_u / c_d above about 3.5. At C = 0.5 the run must stop
+// with a diagnosis while the state is still finite (the energy growth guard), and at C = 0.2
+// it runs.
+TEST(Saturated, AnUnstableRunStopsWithADiagnosisWhileTheStateIsFinite) {
+  auto run = [](double cfl) {
+    test::ThreadCount one(1);
+    test::TempDir dir;
+    const std::string text = fmt::format(R"(
+[geometry]
+dimension = 2
+spacing = 0.04
+[[geometry.block]]
+min = [0.0, 0.0]
+max = [0.4, 0.4]
+[material]
+model = "elastic"
+E = 2.0e7
+nu = 0.3
+density = 2000.0
+[fluid]
+porosity = 0.4
+density = 1000.0
+bulk_modulus = 2.2e9
+conductivity = 1.0e-9
+[solver]
+version = "v3"
+[initial_stress]
+type = "uniform"
+xx = -5.0e4
+yy = -5.0e4
+zz = -5.0e4
+[[boundary]]
+name = "base"
+y = [0.0, 0.0]
+velocity = {{ y = 0.0 }}
+[[boundary]]
+name = "top"
+y = [0.4, 0.4]
+velocity = {{ y = -0.01 }}
+[[boundary]]
+name = "sides"
+x = [0.0, 0.0]
+stress = {{ xx = -5.0e4, xy = 0.0 }}
+[[boundary]]
+name = "right"
+x = [0.4, 0.4]
+stress = {{ xx = -5.0e4, xy = 0.0 }}
+[time]
+end = 0.02
+cfl = {}
+)",
+                                         cfl);
+    auto setup = test::case_from_string<2>(dir, text);
+    StaggeredSolver<2> solver(setup);
+    std::string message;
+    try {
+      while (solver.time() < 0.02 - 1e-12) solver.step();
+    } catch (const SolverError& e) {
+      message = e.what();
+    }
+    double vmax = 0.0;
+    for (double v : solver.node_phi()) vmax = std::max(vmax, std::abs(v));
+    return std::make_pair(message, vmax);
+  };
+  const auto [unstable, v_unstable] = run(0.5);
+  EXPECT_NE(unstable.find("kinetic energy"), std::string::npos) << unstable;
+  EXPECT_NE(unstable.find("unstable"), std::string::npos) << unstable;
+  EXPECT_TRUE(std::isfinite(v_unstable));
+  const auto [stable, v_stable] = run(0.2);
+  EXPECT_TRUE(stable.empty()) << stable;
 }
 
 }  // namespace
