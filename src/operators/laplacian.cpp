@@ -150,4 +150,27 @@ template Eigen::SparseMatrix<double, Eigen::RowMajor> build_filter_gradient_part
     const Eigen::SparseMatrix<double, Eigen::RowMajor>&, const std::vector<Vec<2>>&,
     const std::array<Eigen::SparseMatrix<double, Eigen::RowMajor>, 2>&);
 
+template <int Dim>
+std::array<Eigen::SparseMatrix<double, Eigen::RowMajor>, Dim> gradient_matrices(const CorrectedOperator<Dim>& op,
+                                                                                  Index columns) {
+  std::array<Eigen::SparseMatrix<double, Eigen::RowMajor>, Dim> grad;
+  for (int d = 0; d < Dim; ++d) {
+    std::vector<Eigen::Triplet<double>> t;
+    for (Index a = 0; a < op.rows(); ++a) {
+      const auto r = op.row(a);
+      for (Index k = r.begin; k < r.end; ++k) {
+        t.emplace_back(static_cast<int>(a), static_cast<int>(op.source(r, k)),
+                       op.grad[static_cast<std::size_t>(k)][static_cast<std::size_t>(d)]);
+      }
+    }
+    auto& g = grad[static_cast<std::size_t>(d)];
+    g.resize(op.rows(), columns);
+    g.setFromTriplets(t.begin(), t.end());
+  }
+  return grad;
+}
+
+template std::array<Eigen::SparseMatrix<double, Eigen::RowMajor>, 1> gradient_matrices<1>(const CorrectedOperator<1>&, Index);
+template std::array<Eigen::SparseMatrix<double, Eigen::RowMajor>, 2> gradient_matrices<2>(const CorrectedOperator<2>&, Index);
+
 }  // namespace rktsph

@@ -33,6 +33,7 @@
 #include "core/kernel.hpp"
 #include "core/types.hpp"
 #include "geometry/particles.hpp"
+#include "operators/corrected_operator.hpp"
 
 namespace rktsph {
 
@@ -86,5 +87,11 @@ template <int Dim>
 Eigen::SparseMatrix<double, Eigen::RowMajor> build_filter_gradient_part(
     const Eigen::SparseMatrix<double, Eigen::RowMajor>& symmetric, const std::vector<Vec<Dim>>& position,
     const std::array<Eigen::SparseMatrix<double, Eigen::RowMajor>, Dim>& gradient);
+
+/// The gradient weights of a corrected operator as one sparse matrix per axis (rows its targets,
+/// `columns` its sources): (G_d f)_a = sum_k grad[k][d] f_{source(a, k)}.
+template <int Dim>
+std::array<Eigen::SparseMatrix<double, Eigen::RowMajor>, Dim> gradient_matrices(const CorrectedOperator<Dim>& op,
+                                                                                  Index columns);
 
 }  // namespace rktsph

@@ -130,19 +130,7 @@ void StaggeredSolver<Dim>::build_saturated() {
     // incremental projection leaves undamped, without acting on the linear (and, inside, the
     // quadratic) pressure fields that loads impose at impermeable walls.
     s.filter = fl.filter * fl.saturation * stabilisation_time_ / rho;
-    std::array<PorePressureSolver::Sparse, Dim> grad;
-    for (int d = 0; d < Dim; ++d) {
-      std::vector<Eigen::Triplet<double>> t;
-      for (Index i = 0; i < static_cast<Index>(nn); ++i) {
-        const auto r = op_nn_.row(i);
-        for (Index k = r.begin; k < r.end; ++k) {
-          t.emplace_back(static_cast<int>(i), static_cast<int>(op_nn_.source(r, k)),
-                         op_nn_.grad[static_cast<std::size_t>(k)][static_cast<std::size_t>(d)]);
-        }
-      }
-      grad[static_cast<std::size_t>(d)].resize(static_cast<Eigen::Index>(nn), static_cast<Eigen::Index>(nn));
-      grad[static_cast<std::size_t>(d)].setFromTriplets(t.begin(), t.end());
-    }
+    const auto grad = gradient_matrices<Dim>(op_nn_, static_cast<Index>(nn));
     const NodeLaplacian<Dim> plain = build_node_laplacian<Dim>(disc_.nodes, kernel_);
     const PorePressureSolver::Sparse tg = build_filter_gradient_part<Dim>(plain.symmetric, disc_.nodes.position, grad);
     pressure_ = std::make_unique<PorePressureSolver>(lap.full, lap.symmetric, pw_drained_, s, &plain.symmetric, &tg);

@@ -94,6 +94,9 @@ struct SatRun {
   BandFit band;
   double pw_band = NAN, pw_around = NAN;             // mean p_w in the band / in the zone around it
   int around_count = 0;
+  // The same with the imperfection's nodes (the seed material) left out of both: the shear band
+  // proper, its arms, against their surroundings.
+  double pw_arms = NAN, pw_arms_around = NAN;
   long steps = 0, max_substeps = 0, iterations_max = 0;
   double iterations_mean = 0.0, residual = 0.0, pressure_share = 0.0, seconds = 0.0;
 };
@@ -230,30 +233,42 @@ SatRun run_sample(const std::string& case_file, double dx, double k, double end_
     out.band = fit_band(s.x, s.y, s.eps, kHeight, 0.1, 0.04, 1.0);
     // p_w in the band cloud against the zone around it: the nodes outside the cloud within
     // 0.2 m (about twice the band width of CASES.md) of a cloud node, off the platen margins.
-    double sb = 0.0, sa = 0.0;
-    int nb = 0, na = 0;
-    std::vector<std::size_t> cloud;
+    // The seed: nodes of a material other than the sample's (the most common one).
+    std::vector<std::size_t> per_material;
     for (std::size_t i = 0; i < nn; ++i) {
-      if (out.band.in_band[i]) cloud.push_back(i);
+      const auto m = static_cast<std::size_t>(nodes.material[i]);
+      if (m >= per_material.size()) per_material.resize(m + 1, 0);
+      ++per_material[m];
     }
-    for (std::size_t i = 0; i < nn; ++i) {
-      if (out.band.in_band[i]) {
-        sb += s.pw[i];
-        ++nb;
-        continue;
+    const auto sample_material =
+        static_cast<int>(std::max_element(per_material.begin(), per_material.end()) - per_material.begin());
+    for (const bool skip_seed : {false, true}) {
+      double sb = 0.0, sa = 0.0;
+      int nb = 0, na = 0;
+      std::vector<std::size_t> cloud;
+      for (std::size_t i = 0; i < nn; ++i) {
+        if (out.band.in_band[i] && !(skip_seed && nodes.material[i] != sample_material)) cloud.push_back(i);
       }
-      if (s.y[i] <= 0.1 || s.y[i] >= kHeight - 0.1) continue;
-      for (std::size_t j : cloud) {
-        if (std::hypot(s.x[i] - s.x[j], s.y[i] - s.y[j]) <= 0.2 + 1e-9) {
-          sa += s.pw[i];
-          ++na;
-          break;
+      for (std::size_t i = 0; i < nn; ++i) {
+        if (skip_seed && nodes.material[i] != sample_material) continue;
+        if (out.band.in_band[i]) {
+          sb += s.pw[i];
+          ++nb;
+          continue;
+        }
+        if (s.y[i] <= 0.1 || s.y[i] >= kHeight - 0.1) continue;
+        for (std::size_t j : cloud) {
+          if (std::hypot(s.x[i] - s.x[j], s.y[i] - s.y[j]) <= 0.2 + 1e-9) {
+            sa += s.pw[i];
+            ++na;
+            break;
+          }
         }
       }
+      (skip_seed ? out.pw_arms : out.pw_band) = nb > 0 ? sb / nb : NAN;
+      (skip_seed ? out.pw_arms_around : out.pw_around) = na > 0 ? sa / na : NAN;
+      if (!skip_seed) out.around_count = na;
     }
-    out.pw_band = nb > 0 ? sb / nb : NAN;
-    out.pw_around = na > 0 ? sa / na : NAN;
-    out.around_count = na;
   }
   out.steps = solver.step_count();
   out.max_substeps = solver.max_source_substeps();
@@ -366,11 +381,11 @@ CaseReport validate_case16(const Options& opt, const std::string& dir) {
                       0.20, "");
     if (!m.pass()) {
       m.known_deviation =
-          "open: the 'undrained' sample forms the same conjugate pair of bands from the imperfection as the dry "
-          "case 3, and the k = 1e-9 and 1e-6 runs are nearly identical (p_w does not see k). Suspected cause: the "
-          "non-incremental projection's artificial drainage at the walls (docs/VALIDATION.md case 17, unit test "
-          "Saturated.IncrementalProjectionReducesTheUndrainedPressureLeakUnderGravity); with "
-          "solver.pressure_incremental = true the CoV falls (0.75 at dx = 0.04 m) but stays above 0.2";
+          "the 'undrained' sample forms a conjugate pair of bands from the imperfection. The law has no undrained "
+          "hardening left past its peak (at one material point, same path and rate: q peaks at 221.9 kPa at 2.2 % "
+          "and softens to q_f), so the weaker seed localises the strain; without the imperfection the same run stays "
+          "homogeneous (CoV 0.014 at 8 %, dx = 0.04 m). The wall leak of the old non-incremental projection, "
+          "suspected before, is ruled out: the leak-free defaults give the same CoV (docs/VALIDATION.md, Case 16)";
     }
     rep.metrics.push_back(m);
   }
@@ -403,13 +418,17 @@ CaseReport validate_case16(const Options& opt, const std::string& dir) {
                       (loc.pw_band - loc.pw_around) / 1e3, "<=", 0.0, "kPa");
     if (!m.pass()) {
       m.known_deviation = fmt::format(
-          "open: the k = 1e-6 and 1e-9 runs give the same p_w field (band minus surroundings {:+.2f} and {:+.2f} kPa), so "
-          "what is measured is not water drawn in by the permeability; the same suspected cause as the CoV of eps_vp_eq "
-          "at k = 1e-9 (the non-incremental projection's wall leak)",
-          (loc.pw_band - loc.pw_around) / 1e3, (und.pw_band - und.pw_around) / 1e3);
+          "p_w is higher in the band than around it, for the band's arms alone too (imperfection left out: {:+.2f} "
+          "kPa), and about as much in the practically undrained k = 1e-9 run ({:+.2f} kPa): the contrast is the "
+          "undrained one. Drainage moves it the expected way (k = 1e-6 minus k = 1e-9: {:+.2f} kPa) but over the "
+          "run's 1.6 s it reaches sqrt(c_v t) ~ 0.07 m, a few dx, too little to reverse it",
+          (loc.pw_arms - loc.pw_arms_around) / 1e3, (und.pw_band - und.pw_around) / 1e3,
+          (loc.pw_band - loc.pw_around - (und.pw_band - und.pw_around)) / 1e3);
     }
     rep.metrics.push_back(m);
   }
+  rep.metrics.push_back(metric("k = 1e-6 m/s: mean p_w in the band's arms - within 0.2 m around them (imperfection left out)",
+                               (loc.pw_arms - loc.pw_arms_around) / 1e3, "", 0, "kPa"));
   rep.notes.push_back(fmt::format(
       "k = 1e-6 m/s band {}: {} particles, angle {:.1f} deg (arms {:.1f} / {:.1f}, whole cloud {:.1f}), axis {:.3f} m "
       "from the imperfection centre; mean p_w {:.2f} kPa in the band, {:.2f} kPa in the {} nodes around it",

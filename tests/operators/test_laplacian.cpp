@@ -174,18 +174,7 @@ struct Filter {
 };
 Filter build_filter(const ParticleSet<2>& s, const CubicSplineKernel<2>& kernel) {
   const auto op = build_corrected_operator<2>(s.position, s, kernel);
-  std::array<Eigen::SparseMatrix<double, Eigen::RowMajor>, 2> grad;
-  for (int d = 0; d < 2; ++d) {
-    std::vector<Eigen::Triplet<double>> t;
-    for (Index i = 0; i < s.size(); ++i) {
-      const auto r = op.row(i);
-      for (Index k = r.begin; k < r.end; ++k) {
-        t.emplace_back(static_cast<int>(i), static_cast<int>(op.source(r, k)), op.grad[static_cast<std::size_t>(k)][static_cast<std::size_t>(d)]);
-      }
-    }
-    grad[static_cast<std::size_t>(d)].resize(s.size(), s.size());
-    grad[static_cast<std::size_t>(d)].setFromTriplets(t.begin(), t.end());
-  }
+  const auto grad = gradient_matrices<2>(op, s.size());
   const auto lap = build_node_laplacian<2>(s, kernel);
   return {lap.symmetric, build_filter_gradient_part<2>(lap.symmetric, s.position, grad)};
 }
