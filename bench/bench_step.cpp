@@ -1,4 +1,4 @@
-// Throughput of the V1 time step and of its set-up (neighbour search + operator assembly),
+// Throughput of the V1 and V3 time steps and of the V1 set-up (neighbour search + operator assembly),
 // with the memory it holds per node and a STREAM-like triad for the machine's bandwidth.
 //   scripts/bench.sh            (table + bench/results/<date>-<revision>.json)
 //   build/bench/rktsph_bench --benchmark_counters_tabular=true
@@ -9,12 +9,14 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <string>
 #include <vector>
 
 #include <fmt/format.h>
 
 #include "case/case_setup.hpp"
 #include "operators/corrected_operator.hpp"
+#include "solvers/pore_pressure.hpp"
 #include "solvers/staggered_solver.hpp"
 
 namespace {
@@ -41,11 +43,14 @@ void BM_Triad(benchmark::State& state) {
 }
 BENCHMARK(BM_Triad)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-// A square 2D elastic block with about `nodes` nodes, fixed base, loaded top.
-std::string block_case(long nodes) {
+// A square 2D elastic block with about `nodes` nodes, fixed base, loaded top. `top_extra` and
+// `tables` add keys to the top boundary and tables before [time] (the V3 variant).
+std::string block_case(long nodes, const std::string& top_extra = "", const std::string& tables = "", double cfl = 0.9) {
   const long side = static_cast<long>(std::lround(std::sqrt(static_cast<double>(nodes)))) - 1;
   const double dx = 0.1, length = static_cast<double>(side) * dx;
-  const std::string path = (std::filesystem::temp_directory_path() / fmt::format("rktsph_bench_{}.toml", nodes)).string();
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            fmt::format("rktsph_bench_{}{}.toml", nodes, tables.empty() ? "" : "_v3"))
+                               .string();
   std::ofstream(path) << fmt::format(R"(
 [geometry]
 dimension = 2
@@ -64,10 +69,13 @@ velocity = {{ x = 0.0, y = 0.0 }}
 [[boundary]]
 y = [{L}, {L}]
 stress = {{ yy = -1.0e4 }}
+{top}
+{tables}
 [time]
 end = 1.0
-cfl = 0.9
-)", fmt::arg("dx", dx), fmt::arg("L", length));
+cfl = {cfl}
+)", fmt::arg("dx", dx), fmt::arg("L", length), fmt::arg("top", top_extra), fmt::arg("tables", tables),
+                                     fmt::arg("cfl", cfl));
   return path;
 }
 
@@ -100,6 +108,50 @@ void BM_V1Step(benchmark::State& state) {
 }
 BENCHMARK(BM_V1Step)->Args({10000, 1})->Args({100000, 1})->Args({100000, 2})->Args({1000000, 1})
     ->Args({1000000, 2})->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// The V3 (saturated) step on the same block with a drained top: the explicit V1 part plus the
+// pore-pressure step (right-hand side, PCG solve with the Jacobi preconditioner, velocity
+// correction), with the default incremental projection and pressure filter. `filter` = 0 runs
+// without the filter, to show its cost. K_f = 0.1 GPa keeps C c_u/c_d below the limit of the
+// impermeable free sides (docs/VALIDATION.md, Case 16).
+void BM_V3Step(benchmark::State& state) {
+  omp_set_num_threads(static_cast<int>(state.range(1)));
+  const std::string path = block_case(state.range(0), "pore_pressure = 0.0", fmt::format(R"([fluid]
+porosity = 0.3
+density = 1000.0
+bulk_modulus = 1.0e8
+conductivity = 1.0e-6
+[solver]
+version = "v3"
+pressure_filter = {})", state.range(2) != 0 ? 0.5 : 0.0), 0.5);
+  const CaseDocument doc = load_case_document(path, {});
+  CaseSetup<2> setup = read_case<2>(doc);
+  StaggeredSolver<2> solver(setup);
+  for (int k = 0; k < 20; ++k) solver.step();  // past the first steps' PCG transient
+  const PressureSolveStats* stats = solver.pressure_stats();
+  if (stats == nullptr) {
+    state.SkipWithError("not a V3 run");
+    return;
+  }
+  const PressureSolveStats before = *stats;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (auto _ : state) {
+    solver.step();
+    benchmark::ClobberMemory();
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const PressureSolveStats& after = *stats;
+  const double nodes = static_cast<double>(solver.particles().nodes.size());
+  const double steps = static_cast<double>(state.iterations());
+  state.counters["nodes"] = nodes;
+  state.counters["node_steps/s"] = benchmark::Counter(nodes * steps, benchmark::Counter::kIsRate);
+  state.counters["pcg_iter/step"] = static_cast<double>(after.total_iterations - before.total_iterations) / steps;
+  state.counters["pressure_share"] = (after.seconds - before.seconds) / seconds;
+  state.counters["threads"] = static_cast<double>(state.range(1));
+  state.counters["filter"] = static_cast<double>(state.range(2));
+}
+BENCHMARK(BM_V3Step)->Args({10000, 1, 1})->Args({10000, 1, 0})->Args({100000, 1, 1})->Args({100000, 2, 1})
+    ->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // Neighbour search (cell list) and corrected-operator assembly of both directions, one thread:
 // the set-up the large-deformation version would repeat every step.
