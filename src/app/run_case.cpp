@@ -278,6 +278,15 @@ int run_dim(const RunOptions& opt, const CaseDocument& doc) {
         kVersion, opt.case_file, Dim, solver.particles().nodes.size(),
         solver.particles().elements.size(), dt, solver.cfl(), total_steps,
         omp_get_max_threads(), omp_get_max_threads() > 1 ? "s" : "");
+    if (solver.saturated() && solver.impermeable_stress_face_nodes() > 0 &&
+        solver.undrained_courant() > StaggeredSolver<Dim>::kUndrainedCourantLimit) {
+      std::cerr << fmt::format(
+          "warning: {} boundary nodes are on impermeable faces that carry a total stress (or are free), and the "
+          "undrained Courant number C c_u/c_d = {:.2f} exceeds {}, above which such faces have been measured "
+          "unstable; time.cfl <= {:.3f} keeps it below (docs/VALIDATION.md, Case 16)\n",
+          solver.impermeable_stress_face_nodes(), solver.undrained_courant(), StaggeredSolver<Dim>::kUndrainedCourantLimit,
+          solver.cfl() * StaggeredSolver<Dim>::kUndrainedCourantLimit / solver.undrained_courant());
+    }
     if (solver.degenerate_operator_rows() > 0) {
       std::cerr << fmt::format("warning: {} particles have too few neighbours for the corrected "
                                "operator and use plain SPH sums\n",

@@ -97,6 +97,32 @@ void StaggeredSolver<Dim>::build_saturated() {
     }
   }
 
+  // The undrained Courant number and the faces where it limits stability (see the header).
+  {
+    const double q = 1.0 / fl.inverse_storage();
+    double ratio = 1.0;
+    for (std::size_t m = 0; m < lambda_.size(); ++m) {
+      const double drained = lambda_[m] + 2.0 * shear_[m];
+      ratio = std::max(ratio, std::sqrt((drained + q) / drained));
+    }
+    undrained_courant_ = cfl_ * ratio;
+    impermeable_stress_faces_ = 0;
+    for (const Index i : boundary_nodes_) {
+      const auto iu = static_cast<std::size_t>(i);
+      if (pw_drained_[iu]) continue;
+      bool exposed = false;
+      for (int d = 0; d < Dim; ++d) {
+        if ((disc_.boundary.faces[iu] >> (2 * d) & 3u) == 0) continue;  // not on a face normal to d
+        bool held = false;
+        for (Index k = constraint_row_[iu]; k < constraint_row_[iu + 1]; ++k) {
+          held = held || constraints_[static_cast<std::size_t>(k)].component == d;
+        }
+        exposed = exposed || !held;
+      }
+      if (exposed) ++impermeable_stress_faces_;
+    }
+  }
+
   op_nn_ = build_corrected_operator<Dim>(disc_.nodes.position, disc_.nodes, kernel_);
   const NodeLaplacian<Dim> lap = build_node_laplacian<Dim>(disc_.nodes, kernel_, {}, planes, mask);
 

@@ -752,8 +752,13 @@ void StaggeredSolver<Dim>::finish_step() {
     throw SolverError(fmt::format(
         "the kinetic energy ({:.3g} J) exceeds {:g} times the work done on the body plus its initial energy "
         "({:.3g} J) at step {} (t = {:.6g} s): the run is unstable; reduce the time step (time.cfl = {:.3g}) or check "
-        "the loads, the boundary conditions and the solver options",
-        kinetic, kEnergyGrowthLimit, budget, steps_ + 1, t_new, cfl_));
+        "the loads, the boundary conditions and the solver options{}",
+        kinetic, kEnergyGrowthLimit, budget, steps_ + 1, t_new, cfl_,
+        saturated_ && impermeable_stress_faces_ > 0 && undrained_courant_ > kUndrainedCourantLimit
+            ? fmt::format(" (V3: impermeable faces carrying a total stress are unstable above C c_u/c_d = {}; "
+                          "here it is {:.2f}: time.cfl <= {:.3f})",
+                          kUndrainedCourantLimit, undrained_courant_, cfl_ * kUndrainedCourantLimit / undrained_courant_)
+            : std::string()));
   }
   last_power_ = power;
   last_damping_power_ = damping_power;

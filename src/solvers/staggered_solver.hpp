@@ -112,6 +112,14 @@ class StaggeredSolver {
   const PressureSolveStats* pressure_stats() const { return pressure_ ? &pressure_->stats() : nullptr; }
   double pressure_step_seconds() const { return pressure_seconds_; }
   const PorePressureSolver* pressure_solver() const { return pressure_.get(); }
+  /// V3: C c_u / c_d, the Courant number of the undrained P wave (c_u^2 = (lambda + 2G + Q)/rho),
+  /// largest over the materials, and the number of boundary nodes that are neither drained nor
+  /// held in their normal direction (impermeable faces carrying a prescribed, possibly zero,
+  /// total stress). The step is unstable at such faces once that Courant number exceeds
+  /// kUndrainedCourantLimit (docs/VALIDATION.md, Case 16).
+  double undrained_courant() const { return undrained_courant_; }
+  Index impermeable_stress_face_nodes() const { return impermeable_stress_faces_; }
+  static constexpr double kUndrainedCourantLimit = 3.5;
 
  private:
   void build_constraints();
@@ -173,6 +181,8 @@ class StaggeredSolver {
   // energy accounting
   double external_work_ = 0.0, damping_loss_ = 0.0, initial_strain_ = 0.0;
   double last_power_ = 0.0, last_damping_power_ = 0.0;
+  double undrained_courant_ = 0.0;
+  Index impermeable_stress_faces_ = 0;
   double initial_energy_ = 0.0;  // kinetic + strain (+ fluid storage) at the first step
   static constexpr double kEnergyGrowthLimit = 100.0;  // see finish_step
   double kinetic_peak_ = 0.0, damping_off_time_ = std::numeric_limits<double>::infinity();

@@ -571,6 +571,7 @@ cfl = {}
   const auto [unstable, v_unstable] = run(0.5);
   EXPECT_NE(unstable.find("kinetic energy"), std::string::npos) << unstable;
   EXPECT_NE(unstable.find("unstable"), std::string::npos) << unstable;
+  EXPECT_NE(unstable.find("C c_u/c_d"), std::string::npos) << unstable;  // names the V3 limit and a safe cfl
   EXPECT_TRUE(std::isfinite(v_unstable));
   const auto [stable, v_stable] = run(0.2);
   EXPECT_TRUE(stable.empty()) << stable;
