@@ -27,6 +27,8 @@ struct PorePressureSolver::Impl {
   Eigen::ConjugateGradient<Sparse, Eigen::Lower, Eigen::DiagonalPreconditioner<double>> cg_diag;
   Eigen::ConjugateGradient<Sparse, Eigen::Lower, Eigen::IncompleteCholesky<double>> cg_ic;
   Eigen::VectorXd rhs, x, p_all, p_d;
+  Eigen::VectorXd previous;  // p^n on the free unknowns at the last solve (for the starting guess)
+  bool has_previous = false;
 };
 
 PorePressureSolver::~PorePressureSolver() = default;
@@ -130,11 +132,19 @@ void PorePressureSolver::solve(const std::vector<double>& source, const std::vec
     m.p_all[static_cast<Eigen::Index>(i)] = p_old[i];
     if (index_[i] < 0) m.p_d[nd++] = p[i];
   }
+  // Starting guess: p^n extrapolated linearly in time, 2 p^n - p^{n-1} (p^n on the first solve).
+  // Only the iteration count depends on it, not the converged p^{n+1}.
+  if (m.previous.size() != nf) {
+    m.previous.resize(nf);
+    m.has_previous = false;
+  }
   for (Eigen::Index r = 0; r < nf; ++r) {
     const auto i = static_cast<std::size_t>(free_[static_cast<std::size_t>(r)]);
     m.rhs[r] = source[i];
-    m.x[r] = p_old[i];
+    m.x[r] = m.has_previous ? 2.0 * p_old[i] - m.previous[r] : p_old[i];
+    m.previous[r] = p_old[i];
   }
+  m.has_previous = true;
   // Drained values at t^{n+1}: -K_fd p_d = S_fd p_d.
   if (nd > 0) m.rhs.noalias() += m.S_fd * m.p_d;
   if (settings_.deferred_correction) m.rhs.noalias() += settings_.k_eff * (m.D * m.p_all);
