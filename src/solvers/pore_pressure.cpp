@@ -14,6 +14,14 @@
 
 namespace rktsph {
 
+namespace {
+// From this many unknowns on, the Jacobi-PCG multiplies with the full matrix, which Eigen runs on
+// its OpenMP threads; below, the fork/join of each product costs more than it saves (see Impl).
+// The choice depends on the size only, so that the result does not depend on the thread count
+// (each row's product is the same arithmetic on any number of threads).
+constexpr Eigen::Index kParallelUnknowns = 20000;
+}  // namespace
+
 // Eigen::Lower: CG multiplies with the self-adjoint view of the lower triangle, serially. (With
 // Lower | Upper on a row-major matrix Eigen runs the product on its OpenMP threads, which for
 // a few thousand unknowns costs more in fork/join than it saves: 56 ms instead of ~1 ms per
@@ -26,6 +34,10 @@ struct PorePressureSolver::Impl {
   Sparse F;        // free rows of tau (T G)_f, all columns (explicit half of the pressure filter)
   Eigen::ConjugateGradient<Sparse, Eigen::Lower, Eigen::DiagonalPreconditioner<double>> cg_diag;
   Eigen::ConjugateGradient<Sparse, Eigen::Lower, Eigen::IncompleteCholesky<double>> cg_ic;
+  // Large systems: the full (both triangles) product, which Eigen runs on its OpenMP threads for a
+  // row-major matrix (kParallelUnknowns).
+  Eigen::ConjugateGradient<Sparse, Eigen::Lower | Eigen::Upper, Eigen::DiagonalPreconditioner<double>> cg_diag_parallel;
+  bool parallel = false;
   Eigen::VectorXd rhs, x, p_all, p_d;
   Eigen::VectorXd previous;  // p^n on the free unknowns at the last solve (for the starting guess)
   bool has_previous = false;
@@ -107,10 +119,18 @@ PorePressureSolver::PorePressureSolver(const Sparse& full, const Sparse& symmetr
   if (nf == 0) return;
   // K and its preconditioner are factorised once (METHOD.md §2.4 "Solver").
   if (settings.preconditioner == PressurePreconditioner::diagonal) {
-    impl_->cg_diag.setTolerance(settings.tolerance);
-    impl_->cg_diag.setMaxIterations(settings.max_iterations);
-    impl_->cg_diag.compute(impl_->K);
-    if (impl_->cg_diag.info() != Eigen::Success) throw SolverError("pore pressure: the Jacobi preconditioner failed");
+    impl_->parallel = nf >= kParallelUnknowns;
+    if (impl_->parallel) {
+      impl_->cg_diag_parallel.setTolerance(settings.tolerance);
+      impl_->cg_diag_parallel.setMaxIterations(settings.max_iterations);
+      impl_->cg_diag_parallel.compute(impl_->K);
+      if (impl_->cg_diag_parallel.info() != Eigen::Success) throw SolverError("pore pressure: the Jacobi preconditioner failed");
+    } else {
+      impl_->cg_diag.setTolerance(settings.tolerance);
+      impl_->cg_diag.setMaxIterations(settings.max_iterations);
+      impl_->cg_diag.compute(impl_->K);
+      if (impl_->cg_diag.info() != Eigen::Success) throw SolverError("pore pressure: the Jacobi preconditioner failed");
+    }
   } else {
     impl_->cg_ic.setTolerance(settings.tolerance);
     impl_->cg_ic.setMaxIterations(settings.max_iterations);
@@ -154,10 +174,17 @@ void PorePressureSolver::solve(const std::vector<double>& source, const std::vec
   double error = 0.0;
   bool ok = false;
   if (settings_.preconditioner == PressurePreconditioner::diagonal) {
-    m.x = m.cg_diag.solveWithGuess(m.rhs, m.x);
-    iterations = static_cast<int>(m.cg_diag.iterations());
-    error = m.cg_diag.error();
-    ok = m.cg_diag.info() == Eigen::Success;
+    if (m.parallel) {
+      m.x = m.cg_diag_parallel.solveWithGuess(m.rhs, m.x);
+      iterations = static_cast<int>(m.cg_diag_parallel.iterations());
+      error = m.cg_diag_parallel.error();
+      ok = m.cg_diag_parallel.info() == Eigen::Success;
+    } else {
+      m.x = m.cg_diag.solveWithGuess(m.rhs, m.x);
+      iterations = static_cast<int>(m.cg_diag.iterations());
+      error = m.cg_diag.error();
+      ok = m.cg_diag.info() == Eigen::Success;
+    }
   } else {
     m.x = m.cg_ic.solveWithGuess(m.rhs, m.x);
     iterations = static_cast<int>(m.cg_ic.iterations());
