@@ -44,6 +44,10 @@ class CellList {
 
  private:
   std::array<int, Dim> cell_of(const Vec<Dim>& x) const;
+  /// Call f(first, last) for each contiguous range [first, last) of cell-ordered points that a
+  /// query at x scans (one x-row of cells each), in the fixed order of for_each_neighbour.
+  template <class F>
+  void for_each_range(const Vec<Dim>& x, F&& f) const;
   std::size_t cell_index(const std::array<int, Dim>& c) const {
     std::size_t idx = 0;
     for (int d = Dim - 1; d >= 0; --d) idx = idx * static_cast<std::size_t>(n_[static_cast<std::size_t>(d)]) + static_cast<std::size_t>(c[static_cast<std::size_t>(d)]);
@@ -111,9 +115,9 @@ std::array<int, Dim> CellList<Dim>::cell_of(const Vec<Dim>& x) const {
 
 template <int Dim>
 template <class F>
-void CellList<Dim>::for_each_neighbour(const Vec<Dim>& x, F&& f) const {
+void CellList<Dim>::for_each_range(const Vec<Dim>& x, F&& f) const {
   // A query outside the box is clamped to the border cells; points further than one cell
-  // away from the box cannot have neighbours, which the distance test below enforces.
+  // away from the box cannot have neighbours, which the callers' distance tests enforce.
   const auto c = cell_of(x);
   std::array<int, Dim> lo, hi;
   for (std::size_t d = 0; d < Dim; ++d) {
@@ -122,17 +126,12 @@ void CellList<Dim>::for_each_neighbour(const Vec<Dim>& x, F&& f) const {
   }
   // k runs over the cells in the dimensions above x; along x the cells lo..hi are one range.
   std::array<int, Dim> k = lo;
-  const double r2 = radius_ * radius_;
   while (true) {
     k[0] = lo[0];
     const auto first = static_cast<std::size_t>(cell_start_[cell_index(k)]);
     k[0] = hi[0];
     const auto last = static_cast<std::size_t>(cell_start_[cell_index(k) + 1]);
-    for (std::size_t q = first; q < last; ++q) {
-      const Vec<Dim> xij = x - position_[q];
-      const double d2 = xij.squaredNorm();
-      if (d2 < r2) f(index_[q], xij, std::sqrt(d2));
-    }
+    f(first, last);
     std::size_t d = 1;
     while (d < Dim) {
       if (++k[d] <= hi[d]) break;
@@ -144,20 +143,22 @@ void CellList<Dim>::for_each_neighbour(const Vec<Dim>& x, F&& f) const {
 }
 
 template <int Dim>
+template <class F>
+void CellList<Dim>::for_each_neighbour(const Vec<Dim>& x, F&& f) const {
+  const double r2 = radius_ * radius_;
+  for_each_range(x, [&](std::size_t first, std::size_t last) {
+    for (std::size_t q = first; q < last; ++q) {
+      const Vec<Dim> xij = x - position_[q];
+      const double d2 = xij.squaredNorm();
+      if (d2 < r2) f(index_[q], xij, std::sqrt(d2));
+    }
+  });
+}
+
+template <int Dim>
 std::size_t CellList<Dim>::collect(const Vec<Dim>& x, double r2, std::vector<Hit>& buf) const {
-  const auto c = cell_of(x);
-  std::array<int, Dim> lo, hi;
-  for (std::size_t d = 0; d < Dim; ++d) {
-    lo[d] = std::max(0, c[d] - reach_);
-    hi[d] = std::min(n_[d] - 1, c[d] + reach_);
-  }
-  std::array<int, Dim> k = lo;
   std::size_t count = 0;
-  while (true) {
-    k[0] = lo[0];
-    const auto first = static_cast<std::size_t>(cell_start_[cell_index(k)]);
-    k[0] = hi[0];
-    const auto last = static_cast<std::size_t>(cell_start_[cell_index(k) + 1]);
+  for_each_range(x, [&](std::size_t first, std::size_t last) {
     if (buf.size() < count + (last - first)) buf.resize(count + (last - first));
     Hit* o = buf.data();
     for (std::size_t q = first; q < last; ++q) {
@@ -166,14 +167,7 @@ std::size_t CellList<Dim>::collect(const Vec<Dim>& x, double r2, std::vector<Hit
       o[count] = {index_[q], xij, d2};
       count += d2 < r2 ? 1 : 0;
     }
-    std::size_t d = 1;
-    while (d < Dim) {
-      if (++k[d] <= hi[d]) break;
-      k[d] = lo[d];
-      ++d;
-    }
-    if (d >= Dim) break;
-  }
+  });
   return count;
 }
 
