@@ -118,26 +118,19 @@ PorePressureSolver::PorePressureSolver(const Sparse& full, const Sparse& symmetr
   impl_->p_d.resize(nd);
   if (nf == 0) return;
   // K and its preconditioner are factorised once (METHOD.md §2.4 "Solver").
-  if (settings.preconditioner == PressurePreconditioner::diagonal) {
-    impl_->parallel = nf >= kParallelUnknowns;
-    if (impl_->parallel) {
-      impl_->cg_diag_parallel.setTolerance(settings.tolerance);
-      impl_->cg_diag_parallel.setMaxIterations(settings.max_iterations);
-      impl_->cg_diag_parallel.compute(impl_->K);
-      if (impl_->cg_diag_parallel.info() != Eigen::Success) throw SolverError("pore pressure: the Jacobi preconditioner failed");
-    } else {
-      impl_->cg_diag.setTolerance(settings.tolerance);
-      impl_->cg_diag.setMaxIterations(settings.max_iterations);
-      impl_->cg_diag.compute(impl_->K);
-      if (impl_->cg_diag.info() != Eigen::Success) throw SolverError("pore pressure: the Jacobi preconditioner failed");
-    }
+  auto prepare = [&](auto& cg, const char* what) {
+    cg.setTolerance(settings.tolerance);
+    cg.setMaxIterations(settings.max_iterations);
+    cg.compute(impl_->K);
+    if (cg.info() != Eigen::Success) throw SolverError(fmt::format("pore pressure: {} failed", what));
+  };
+  impl_->parallel = settings.preconditioner == PressurePreconditioner::diagonal && nf >= kParallelUnknowns;
+  if (settings.preconditioner == PressurePreconditioner::incomplete_cholesky) {
+    prepare(impl_->cg_ic, "the incomplete-Cholesky factorisation of K");
+  } else if (impl_->parallel) {
+    prepare(impl_->cg_diag_parallel, "the Jacobi preconditioner");
   } else {
-    impl_->cg_ic.setTolerance(settings.tolerance);
-    impl_->cg_ic.setMaxIterations(settings.max_iterations);
-    impl_->cg_ic.compute(impl_->K);
-    if (impl_->cg_ic.info() != Eigen::Success) {
-      throw SolverError("pore pressure: the incomplete-Cholesky factorisation of K failed");
-    }
+    prepare(impl_->cg_diag, "the Jacobi preconditioner");
   }
 }
 
@@ -173,23 +166,18 @@ void PorePressureSolver::solve(const std::vector<double>& source, const std::vec
   int iterations = 0;
   double error = 0.0;
   bool ok = false;
-  if (settings_.preconditioner == PressurePreconditioner::diagonal) {
-    if (m.parallel) {
-      m.x = m.cg_diag_parallel.solveWithGuess(m.rhs, m.x);
-      iterations = static_cast<int>(m.cg_diag_parallel.iterations());
-      error = m.cg_diag_parallel.error();
-      ok = m.cg_diag_parallel.info() == Eigen::Success;
-    } else {
-      m.x = m.cg_diag.solveWithGuess(m.rhs, m.x);
-      iterations = static_cast<int>(m.cg_diag.iterations());
-      error = m.cg_diag.error();
-      ok = m.cg_diag.info() == Eigen::Success;
-    }
+  auto run = [&](auto& cg) {
+    m.x = cg.solveWithGuess(m.rhs, m.x);
+    iterations = static_cast<int>(cg.iterations());
+    error = cg.error();
+    ok = cg.info() == Eigen::Success;
+  };
+  if (settings_.preconditioner == PressurePreconditioner::incomplete_cholesky) {
+    run(m.cg_ic);
+  } else if (m.parallel) {
+    run(m.cg_diag_parallel);
   } else {
-    m.x = m.cg_ic.solveWithGuess(m.rhs, m.x);
-    iterations = static_cast<int>(m.cg_ic.iterations());
-    error = m.cg_ic.error();
-    ok = m.cg_ic.info() == Eigen::Success;
+    run(m.cg_diag);
   }
   if (!ok || !std::isfinite(error)) {
     throw SolverError(fmt::format("pore pressure: the conjugate gradient did not converge ({} iterations, "

@@ -178,6 +178,14 @@ void StaggeredSolver<Dim>::pressure_step(double t_new) {
   const Index* off = op_nn_.offset.data();
   const auto* wg = op_nn_.grad.data();
   double* phi = node_phi_.data();
+  // Same-set corrected gradient of a nodal scalar at node i (that of the velocity correction).
+  auto node_gradient = [&](const std::vector<double>& f, Index i, double (&g)[Dim]) {
+    for (int d = 0; d < Dim; ++d) g[d] = 0.0;
+    for (Index k = pstart[pat[i]]; k < pstart[pat[i] + 1]; ++k) {
+      const double fk = f[static_cast<std::size_t>(base[i] + off[k])];
+      for (int d = 0; d < Dim; ++d) g[d] += wg[k][static_cast<std::size_t>(d)] * fk;
+    }
+  };
   // RHS_I = p^n_I/(Q* dt) - S_w (div v*)_I; drained nodes take their value at t^{n+1}.
   //
   // solver.pressure_divergence = "stress_points": div of the stress points' pressure-free half-
@@ -218,11 +226,8 @@ void StaggeredSolver<Dim>::pressure_step(double t_new) {
 #pragma omp parallel for schedule(static) if (nn > kParallelMinV3)
     for (Index i = 0; i < nn; ++i) {
       const auto iu = static_cast<std::size_t>(i);
-      double g[Dim] = {};
-      for (Index k = pstart[pat[i]]; k < pstart[pat[i] + 1]; ++k) {
-        const double p = pw_old_[static_cast<std::size_t>(base[i] + off[k])];
-        for (int d = 0; d < Dim; ++d) g[d] += wg[k][static_cast<std::size_t>(d)] * p;
-      }
+      double g[Dim];
+      node_gradient(pw_old_, i, g);
       for (int d = 0; d < Dim; ++d) pw_grad_[iu * Dim + static_cast<std::size_t>(d)] = g[d] / disc_.nodes.density[iu];
     }
     // A prescribed velocity component is not corrected (apply_constraints resets it), so it
@@ -250,11 +255,8 @@ void StaggeredSolver<Dim>::pressure_step(double t_new) {
 #pragma omp parallel for schedule(static) if (nn > kParallelMinV3)
   for (Index i = 0; i < nn; ++i) {
     const auto iu = static_cast<std::size_t>(i);
-    double g[Dim] = {};
-    for (Index k = pstart[pat[i]]; k < pstart[pat[i] + 1]; ++k) {
-      const double p = pw_[static_cast<std::size_t>(base[i] + off[k])];
-      for (int d = 0; d < Dim; ++d) g[d] += wg[k][static_cast<std::size_t>(d)] * p;
-    }
+    double g[Dim];
+    node_gradient(pw_, i, g);
     const double f = dt_ / disc_.nodes.density[iu];
     for (int d = 0; d < Dim; ++d) phi[iu * NV + static_cast<std::size_t>(d)] -= f * g[d];
   }

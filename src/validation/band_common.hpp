@@ -9,6 +9,23 @@
 
 namespace rktsph::validation {
 
+/// The plane-strain sample and platen loading of CASES.md Case 3, which Case 16 reuses: 1 m x
+/// 2 m, the top platen driven down at 0.1 m/s reached by a linear ramp over 0.1 s.
+constexpr double kSampleHeight = 2.0, kSampleWidth = 1.0;
+constexpr double kPlatenRampTime = 0.1, kPlatenSpeed = 0.1;
+
+/// Axial strain of the platen at time t.
+inline double platen_strain(double t) {
+  const double u = t <= kPlatenRampTime ? 0.5 * kPlatenSpeed * t * t / kPlatenRampTime
+                                        : 0.5 * kPlatenSpeed * kPlatenRampTime + kPlatenSpeed * (t - kPlatenRampTime);
+  return u / kSampleHeight;
+}
+
+/// Time at which the platen reaches the axial strain `strain` (past the ramp).
+inline double platen_time(double strain) {
+  return kPlatenRampTime + (strain * kSampleHeight - 0.5 * kPlatenSpeed * kPlatenRampTime) / kPlatenSpeed;
+}
+
 /// A nodal history variable by name (e.g. "eps_vp_eq"), read as node_history()[i]; throws
 /// SolverError naming `who` if the materials carry no such variable.
 class NodeHistory {

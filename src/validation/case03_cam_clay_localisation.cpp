@@ -22,8 +22,7 @@ namespace {
 
 // CASES.md Case 3 material and loading.
 constexpr double kE = 2.0e7, kNu = 0.3, kM = 1.2, kP0 = 5.0e4, kPc0 = 4.0e5;
-constexpr double kHeight = 2.0, kWidth = 1.0;
-constexpr double kRampTime = 0.1, kPlatenSpeed = 0.1;
+constexpr double kHeight = kSampleHeight, kWidth = kSampleWidth;
 
 /// Closed-form elastic path (CASES.md Case 3): s = sigma_1 - sigma_3, compression positive.
 struct ElasticPath {
@@ -40,13 +39,6 @@ struct ElasticPath {
     return (-b + std::sqrt(b * b - 4.0 * a * c)) / (2.0 * a);
   }
 };
-
-/// Axial strain of the platen at time t (ramped speed, CASES.md Case 3).
-double platen_strain(double t) {
-  const double u = t <= kRampTime ? 0.5 * kPlatenSpeed * t * t / kRampTime
-                                  : 0.5 * kPlatenSpeed * kRampTime + kPlatenSpeed * (t - kRampTime);
-  return u / kHeight;
-}
 
 struct Snapshot {
   double strain = 0.0;
@@ -84,7 +76,7 @@ void band_angle(const Snapshot& s, SampleResult& r) {
 
 SampleResult run_sample(const std::string& case_file, double dx, double end_strain,
                         const std::vector<double>& snap_strains, double q_y) {
-  const double t_end = kRampTime + (end_strain * kHeight - 0.5 * kPlatenSpeed * kRampTime) / kPlatenSpeed;
+  const double t_end = platen_time(end_strain);
   std::vector<std::string> set = {
       fmt::format("geometry.spacing={}", dx),
       fmt::format("time.end={}", t_end),

@@ -27,8 +27,7 @@ namespace {
 constexpr double kE = 2.0e7, kNu = 0.3, kM = 1.2, kP0 = 5.0e4, kPc0 = 4.0e5;
 constexpr double kLambda = 0.20, kKappa = 0.02, kE0 = 1.0;
 constexpr double kPorosity = 0.4, kKf = 2.2e9;
-constexpr double kHeight = 2.0, kWidth = 1.0;
-constexpr double kRampTime = 0.1, kPlatenSpeed = 0.1;
+constexpr double kHeight = kSampleHeight, kWidth = kSampleWidth;
 // First yield is taken where the volume-averaged eps_vp_eq first reaches this value (1.7 % of
 // the first-yield axial strain): the sample's response leaves the elastic path there.
 constexpr double kYieldEps = 1.0e-4;
@@ -68,12 +67,6 @@ struct Undrained {
   }
 };
 
-double platen_strain(double t) {
-  const double u = t <= kRampTime ? 0.5 * kPlatenSpeed * t * t / kRampTime
-                                  : 0.5 * kPlatenSpeed * kRampTime + kPlatenSpeed * (t - kRampTime);
-  return u / kHeight;
-}
-
 struct Snapshot {
   double strain = 0.0;
   std::vector<double> x, y, eps, pw, q, vx, vy;
@@ -106,7 +99,7 @@ std::string label(double k) { return fmt::format("k{:g}", k); }
 SatRun run_sample(const std::string& case_file, double dx, double k, double end_strain,
                   const std::vector<double>& snap_strains, const Undrained& u) {
   const double s_y = u.yield_s(), eps_y = u.strain(s_y);
-  const double t_end = kRampTime + (end_strain * kHeight - 0.5 * kPlatenSpeed * kRampTime) / kPlatenSpeed;
+  const double t_end = platen_time(end_strain);
   std::vector<std::string> set = {fmt::format("geometry.spacing={}", dx), fmt::format("time.end={}", t_end),
                                   fmt::format("fluid.conductivity={:g}", k), "output.interval=0"};
   if (std::abs(std::remainder(0.5 * kWidth, dx)) > 1e-9) {  // no node at x = 0.5 m: pin the nearest
