@@ -12,7 +12,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-from plot_common import read  # noqa: E402
+from plot_common import read, style_crest_history  # noqa: E402
 
 
 
@@ -24,18 +24,7 @@ def histories(d, fig_path, title, pattern_labels, H=10.0):
             dx = p.stem.split("_dx")[-1]
             axes[0].plot(h["t"], h["uc"], label=f"{label}, dx = {dx} m")
             axes[1].semilogy(h["t"], [max(k, 1e-12) for k in h["kinetic"]], label=f"{label}, dx = {dx} m")
-    top = max(max(l.get_ydata()) for l in axes[1].get_lines())
-    axes[1].set_ylim(bottom=1e-6 * top)
-    axes[0].axhline(0.05 * H, color="r", ls=":", label="collapse threshold 0.05 H")
-    axes[0].set_ylabel("crest horizontal displacement $u_c$ (m, outward +)")
-    axes[0].set_yscale("symlog", linthresh=1e-3)
-    axes[1].set_ylabel("kinetic energy (J/m)")
-    for ax in axes:
-        ax.axvline(3.0, color="0.5", ls="--", lw=0.8, label="end of the gravity ramp")
-        ax.axvline(5.0, color="0.5", ls=":", lw=0.8, label="damping off at the latest (damping.until)")
-        ax.set_xlabel("t (s)")
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=7)
+    style_crest_history(axes, H, [(3.0, "--", "end of the gravity ramp"), (5.0, ":", "damping off at the latest (damping.until)")])
     fig.suptitle(title)
     fig.tight_layout()
     fig.savefig(fig_path, dpi=110)

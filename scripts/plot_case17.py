@@ -12,7 +12,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-from plot_common import read  # noqa: E402
+from plot_common import read, style_crest_history  # noqa: E402
 
 RUNS = [("N3.4_k1e-05", "N = 3.4, k = 1e-5 m/s"), ("N3.4_k1e-07", "N = 3.4, k = 1e-7 m/s"),
         ("N4.2_k1e-05", "N = 4.2, k = 1e-5 m/s"), ("N4.2_k1e-07", "N = 4.2, k = 1e-7 m/s")]
@@ -32,18 +32,7 @@ def main(d):
         ls = "-" if "k1e-05" in tag else "--"
         axes[0].plot(h["t"], h["uc"], ls, label=lab)
         axes[1].semilogy(h["t"], [max(k, 1e-12) for k in h["kinetic"]], ls, label=lab)
-    top = max(max(l.get_ydata()) for l in axes[1].get_lines())
-    axes[1].set_ylim(bottom=1e-6 * top)
-    axes[0].axhline(0.05 * H, color="r", ls=":", label="collapse threshold 0.05 H")
-    axes[0].set_ylabel("crest horizontal displacement $u_c$ (m, outward +)")
-    axes[0].set_yscale("symlog", linthresh=1e-3)
-    axes[1].set_ylabel("kinetic energy (J/m)")
-    for ax in axes:
-        ax.axvline(3.0, color="0.5", ls="--", lw=0.8, label="end of the gravity ramp")
-        ax.axvline(6.0, color="0.5", ls=":", lw=0.8, label="t = 6 s (u_c compared between k)")
-        ax.set_xlabel("t (s)")
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=7)
+    style_crest_history(axes, H, [(3.0, "--", "end of the gravity ramp"), (6.0, ":", "t = 6 s (u_c compared between k)")])
     fig.suptitle(f"Case 17: saturated cut, crest displacement and kinetic energy (dx = {dx:g} m)")
     fig.tight_layout()
     fig.savefig(d / "histories.png", dpi=110)
