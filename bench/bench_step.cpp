@@ -14,10 +14,11 @@
 
 #include <fmt/format.h>
 
-#include "case/case_setup.hpp"
+#include "case/case_reader.hpp"
 #include "operators/corrected_operator.hpp"
-#include "solvers/pore_pressure.hpp"
-#include "solvers/staggered_solver.hpp"
+#include "linear_solvers/pore_pressure.hpp"
+#include "schemes/pressure_stage.hpp"
+#include "schemes/simulation.hpp"
 
 namespace {
 
@@ -79,20 +80,53 @@ cfl = {cfl}
   return path;
 }
 
+// A model of the compulsory memory traffic of one V1 step with the default velocity filter:
+// per pass, the arrays it reads plus those it writes (reads and writes counted apart), each
+// particle's data once (the gathers are assumed to hit the cache after a particle's first use,
+// which lattice order gives). The benchmark divides it by the step time for the effective
+// bandwidth.
+std::size_t step_traffic_bytes(const Simulation<2>& s) {
+  const auto& m = s.model();
+  const auto nn = static_cast<std::size_t>(m.nodes.size());
+  const auto ne = static_cast<std::size_t>(m.stress_points.size());
+  constexpr std::size_t vec = 2 * sizeof(double), str = kStressComponents<2> * sizeof(double), phi = vec + str;
+  const std::size_t props = sizeof(double) + sizeof(int);  // density, material
+  const std::size_t hist = static_cast<std::size_t>(m.materials.history.stride()) * sizeof(double);
+  const std::size_t src = m.materials.any_source ? 2 * str : 0;  // sigma_start, rate
+  auto rows = [](const CorrectedOperator<2>& op) {
+    return op.bytes() - op.interp.size() * sizeof(double) - op.grad.size() * sizeof(op.grad[0]);
+  };
+  const std::size_t row_en = rows(m.to_stress_points), row_ne = rows(m.to_nodes);
+  std::size_t bytes = 0;
+  // step 1: node v, sigma, history -> stress-point v, sigma, history (+ source inputs)
+  bytes += nn * (phi + hist) + ne * (phi + hist + props + src) + row_en;
+  // step 2: stress-point v, sigma; node v, sigma, u -> node v, sigma, u (+ source inputs)
+  bytes += ne * phi + nn * (2 * phi + 2 * vec + props + sizeof(Index) + src) + row_ne;
+  if (m.setup.filter) {
+    bytes += nn * vec + ne * vec + row_en;              // P_EN v
+    bytes += ne * vec + nn * (vec + vec) + row_ne;      // v - P_NE P_EN v
+    bytes += nn * vec + ne * vec + row_en;              // P_EN of that
+    bytes += ne * vec + nn * (vec + 2 * vec) + row_ne;  // v -= eps (...)
+  }
+  // balance: volume, density, v
+  bytes += nn * (2 * sizeof(double) + vec);
+  return bytes;
+}
+
 void BM_V1Step(benchmark::State& state) {
   omp_set_num_threads(static_cast<int>(state.range(1)));
   const CaseDocument doc = load_case_document(block_case(state.range(0)), {});
   CaseSetup<2> setup = read_case<2>(doc);
-  StaggeredSolver<2> solver(setup);
+  Simulation<2> solver(setup);
   const auto t0 = std::chrono::steady_clock::now();
   for (auto _ : state) {
     solver.step();
     benchmark::ClobberMemory();
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  const double nodes = static_cast<double>(solver.particles().nodes.size());
+  const double nodes = static_cast<double>(solver.nodes().size());
   const double steps = static_cast<double>(state.iterations());
-  const double traffic = static_cast<double>(solver.step_traffic_bytes());
+  const double traffic = static_cast<double>(step_traffic_bytes(solver));
   state.counters["nodes"] = nodes;
   state.counters["node_steps/s"] = benchmark::Counter(nodes * steps, benchmark::Counter::kIsRate);
   state.counters["pairs/node"] = static_cast<double>(solver.pairs()) / nodes;
@@ -100,7 +134,7 @@ void BM_V1Step(benchmark::State& state) {
   state.counters["operator_B/node"] = static_cast<double>(solver.operator_bytes()) / nodes;
   state.counters["patterns"] = static_cast<double>(solver.operator_patterns());
   state.counters["threads"] = static_cast<double>(state.range(1));
-  // Effective bandwidth: the step's compulsory traffic (StaggeredSolver::step_traffic_bytes)
+  // Effective bandwidth: the step's compulsory traffic (step_traffic_bytes above)
   // over its time, and its fraction of the triad of this run.
   state.counters["traffic_B/node"] = traffic / nodes;
   state.counters["GB/s"] = benchmark::Counter(traffic * steps / 1e9, benchmark::Counter::kIsRate);
@@ -126,9 +160,10 @@ version = "v3"
 pressure_filter = {})", state.range(2) != 0 ? 0.5 : 0.0), 0.5);
   const CaseDocument doc = load_case_document(path, {});
   CaseSetup<2> setup = read_case<2>(doc);
-  StaggeredSolver<2> solver(setup);
+  Simulation<2> solver(setup);
   for (int k = 0; k < 20; ++k) solver.step();  // past the first steps' PCG transient
-  const PressureSolveStats* stats = solver.pressure_stats();
+  const auto* pressure = solver.scheme().find<PorePressureStage<2>>();
+  const PressureSolveStats* stats = pressure != nullptr ? &pressure->stats() : nullptr;
   if (stats == nullptr) {
     state.SkipWithError("not a V3 run");
     return;
@@ -141,7 +176,7 @@ pressure_filter = {})", state.range(2) != 0 ? 0.5 : 0.0), 0.5);
   }
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   const PressureSolveStats& after = *stats;
-  const double nodes = static_cast<double>(solver.particles().nodes.size());
+  const double nodes = static_cast<double>(solver.nodes().size());
   const double steps = static_cast<double>(state.iterations());
   state.counters["nodes"] = nodes;
   state.counters["node_steps/s"] = benchmark::Counter(nodes * steps, benchmark::Counter::kIsRate);
@@ -159,11 +194,11 @@ void BM_OperatorSetup(benchmark::State& state) {
   omp_set_num_threads(1);
   const CaseDocument doc = load_case_document(block_case(state.range(0)), {});
   const CaseSetup<2> setup = read_case<2>(doc);
-  const Discretisation<2> disc = discretise<2>(setup.blocks, setup.dx, setup.origin, {2000.0});
+  const LatticeParticles<2> disc = generate_lattice<2>(setup.blocks, setup.dx, setup.origin, {2000.0});
   const CubicSplineKernel<2> kernel(setup.h_over_dx * setup.dx);
   for (auto _ : state) {
-    const auto en = build_corrected_operator<2>(disc.elements.position, disc.nodes, kernel);
-    const auto ne = build_corrected_operator<2>(disc.nodes.position, disc.elements, kernel);
+    const auto en = build_corrected_operator<2>(disc.stress_points.position, disc.nodes, kernel);
+    const auto ne = build_corrected_operator<2>(disc.nodes.position, disc.stress_points, kernel);
     benchmark::DoNotOptimize(en.base.data());
     benchmark::DoNotOptimize(ne.base.data());
   }
@@ -181,9 +216,9 @@ void BM_V1Setup(benchmark::State& state) {
   double nodes = 0;
   for (auto _ : state) {
     CaseSetup<2> setup = read_case<2>(doc);
-    StaggeredSolver<2> solver(setup);
-    nodes = static_cast<double>(solver.particles().nodes.size());
-    benchmark::DoNotOptimize(solver.node_phi().data());
+    Simulation<2> solver(setup);
+    nodes = static_cast<double>(solver.nodes().size());
+    benchmark::DoNotOptimize(solver.nodes().position.data());
   }
   state.counters["nodes"] = nodes;
   state.counters["us/node"] = benchmark::Counter(nodes * static_cast<double>(state.iterations()),

@@ -11,7 +11,7 @@
 #include "app/material_point.hpp"
 #include "app/run_case.hpp"
 #include "core/error.hpp"
-#include "materials/material.hpp"
+#include "case/material_reader.hpp"
 #include "rktsph/version.hpp"
 #include "validation/validation.hpp"
 

@@ -16,11 +16,13 @@
 #include <fmt/ranges.h>
 #include <nlohmann/json.hpp>
 
-#include "case/case_setup.hpp"
+#include "case/case_reader.hpp"
 #include "core/error.hpp"
+#include "io/field_catalogue.hpp"
 #include "io/vtu_writer.hpp"
 #include "rktsph/version.hpp"
-#include "solvers/staggered_solver.hpp"
+#include "schemes/pressure_stage.hpp"
+#include "schemes/simulation.hpp"
 
 namespace rktsph {
 
@@ -29,78 +31,6 @@ using Clock = std::chrono::steady_clock;
 
 namespace {
 
-enum class FieldKind { velocity, displacement, stress, pressure, von_mises, history, pore_pressure, total_stress };
-struct FieldRef {
-  FieldKind kind;
-  int index = 0;
-};
-
-template <int Dim>
-FieldRef parse_field(const std::string& name, const StaggeredSolver<Dim>& s, const ProbeSpec& probe) {
-  for (int d = 0; d < Dim; ++d) {
-    const auto axis = kAxisNames[static_cast<std::size_t>(d)];
-    if (name.size() == 2 && name.substr(1) == axis) {
-      if (name[0] == 'v') return {FieldKind::velocity, d};
-      if (name[0] == 'u') return {FieldKind::displacement, d};
-    }
-  }
-  for (std::size_t c = 0; c < 6; ++c) {
-    if (name.size() == 3 && name[0] == 's' && name.substr(1) == kStressComponentNames[c]) {
-      const int sl = stress_slot<Dim>(static_cast<StressComponent>(c));
-      if (sl >= 0) return {FieldKind::stress, sl};
-    }
-  }
-  if (name == "p") return {FieldKind::pressure, 0};
-  if (s.saturated()) {  // V3: pore pressure and total stresses (sigma' - p_w 1)
-    if (name == "pw") return {FieldKind::pore_pressure, 0};
-    for (std::size_t c = 0; c < 6; ++c) {
-      if (name == fmt::format("total_s{}", kStressComponentNames[c])) {
-        const int sl = stress_slot<Dim>(static_cast<StressComponent>(c));
-        if (sl >= 0) return {FieldKind::total_stress, sl};
-      }
-    }
-  }
-  if (name == "q") return {FieldKind::von_mises, 0};
-  const auto& names = s.history_names();
-  for (std::size_t i = 0; i < names.size(); ++i) {
-    if (names[i] == name) return {FieldKind::history, static_cast<int>(i)};
-  }
-  std::vector<std::string> known;
-  for (int d = 0; d < Dim; ++d) known.push_back(fmt::format("v{}", kAxisNames[static_cast<std::size_t>(d)]));
-  for (int d = 0; d < Dim; ++d) known.push_back(fmt::format("u{}", kAxisNames[static_cast<std::size_t>(d)]));
-  for (std::size_t c = 0; c < 6; ++c) {
-    if (stress_slot<Dim>(static_cast<StressComponent>(c)) >= 0) known.push_back(fmt::format("s{}", kStressComponentNames[c]));
-  }
-  known.insert(known.end(), {"p", "q"});
-  if (s.saturated()) known.insert(known.end(), {"pw", "total_sxx", "..."});
-  known.insert(known.end(), names.begin(), names.end());
-  throw InputError(fmt::format("{}, key 'probe.fields': unknown field '{}' for probe '{}' "
-                               "(available: {})",
-                               probe.where, name, probe.name, fmt::join(known, ", ")));
-}
-
-template <int Dim>
-double node_field(const StaggeredSolver<Dim>& s, Index node, const FieldRef& f) {
-  constexpr int NV = StaggeredSolver<Dim>::NV;
-  const auto i = static_cast<std::size_t>(node);
-  const double* phi = &s.node_phi()[i * NV];
-  switch (f.kind) {
-    case FieldKind::velocity: return phi[f.index];
-    case FieldKind::displacement: return s.node_displacement()[i * Dim + static_cast<std::size_t>(f.index)];
-    case FieldKind::stress: return phi[Dim + f.index];
-    case FieldKind::pressure: return invariants(to_sym6<Dim>(phi + Dim)).p;
-    case FieldKind::pore_pressure: return s.node_pore_pressure()[i];
-    case FieldKind::total_stress: return phi[Dim + f.index] - (f.index < 3 ? s.node_pore_pressure()[i] : 0.0);
-    case FieldKind::von_mises: return invariants(to_sym6<Dim>(phi + Dim)).q;
-    case FieldKind::history: {
-      const int m = s.particles().nodes.material[i];
-      const int slot = s.history_slot(m, static_cast<std::size_t>(f.index));
-      return slot < 0 ? 0.0 : s.node_history()[i * static_cast<std::size_t>(s.history_stride()) + static_cast<std::size_t>(slot)];
-    }
-  }
-  return 0.0;
-}
-
 template <int Dim>
 std::vector<double> padded_points(const std::vector<Vec<Dim>>& x) {
   std::vector<double> pts(x.size() * 3, 0.0);
@@ -108,69 +38,6 @@ std::vector<double> padded_points(const std::vector<Vec<Dim>>& x) {
     for (int d = 0; d < Dim; ++d) pts[i * 3 + static_cast<std::size_t>(d)] = x[i][d];
   }
   return pts;
-}
-
-// Fields of one particle set: velocity, (displacement), stress components, p, q, history.
-template <int Dim>
-std::vector<io::PointField> set_fields(const StaggeredSolver<Dim>& s, bool nodes) {
-  constexpr int NV = StaggeredSolver<Dim>::NV;
-  const auto& phi = nodes ? s.node_phi() : s.element_phi();
-  const auto& set = nodes ? s.particles().nodes : s.particles().elements;
-  const auto n = static_cast<std::size_t>(set.size());
-  std::vector<io::PointField> out;
-  io::PointField vel{"velocity", 3, std::vector<double>(n * 3, 0.0)};
-  for (std::size_t i = 0; i < n; ++i) {
-    for (int d = 0; d < Dim; ++d) vel.values[i * 3 + static_cast<std::size_t>(d)] = phi[i * NV + static_cast<std::size_t>(d)];
-  }
-  out.push_back(std::move(vel));
-  if (nodes) {
-    io::PointField disp{"displacement", 3, std::vector<double>(n * 3, 0.0)};
-    for (std::size_t i = 0; i < n; ++i) {
-      for (int d = 0; d < Dim; ++d) disp.values[i * 3 + static_cast<std::size_t>(d)] = s.node_displacement()[i * Dim + static_cast<std::size_t>(d)];
-    }
-    out.push_back(std::move(disp));
-  }
-  for (std::size_t c = 0; c < 6; ++c) {
-    const int sl = stress_slot<Dim>(static_cast<StressComponent>(c));
-    if (sl < 0) continue;
-    io::PointField f{fmt::format("s{}", kStressComponentNames[c]), 1, std::vector<double>(n)};
-    for (std::size_t i = 0; i < n; ++i) f.values[i] = phi[i * NV + static_cast<std::size_t>(Dim + sl)];
-    out.push_back(std::move(f));
-  }
-  io::PointField p{"p", 1, std::vector<double>(n)}, q{"q", 1, std::vector<double>(n)};
-  for (std::size_t i = 0; i < n; ++i) {
-    const Invariants inv = invariants(to_sym6<Dim>(&phi[i * NV + Dim]));
-    p.values[i] = inv.p;
-    q.values[i] = inv.q;
-  }
-  out.push_back(std::move(p));
-  out.push_back(std::move(q));
-  const auto& hist = nodes ? s.node_history() : s.element_history();
-  for (std::size_t h = 0; h < s.history_names().size(); ++h) {
-    io::PointField f{s.history_names()[h], 1, std::vector<double>(n, 0.0)};
-    for (std::size_t i = 0; i < n; ++i) {
-      const int slot = s.history_slot(set.material[i], h);
-      if (slot >= 0) f.values[i] = hist[i * static_cast<std::size_t>(s.history_stride()) + static_cast<std::size_t>(slot)];
-    }
-    out.push_back(std::move(f));
-  }
-  if (nodes && s.saturated()) {
-    // V3: pore pressure (compression positive) and the total stresses sigma' - p_w 1; the
-    // stress fields above are effective stresses.
-    const auto& pw = s.node_pore_pressure();
-    out.push_back({"pw", 1, pw});
-    for (std::size_t c = 0; c < 6; ++c) {
-      const int sl = stress_slot<Dim>(static_cast<StressComponent>(c));
-      if (sl < 0) continue;
-      io::PointField f{fmt::format("total_s{}", kStressComponentNames[c]), 1, std::vector<double>(n)};
-      for (std::size_t i = 0; i < n; ++i) f.values[i] = phi[i * NV + static_cast<std::size_t>(Dim + sl)] - (c < 3 ? pw[i] : 0.0);
-      out.push_back(std::move(f));
-    }
-  }
-  io::PointField mat{"material", 1, std::vector<double>(n)};
-  for (std::size_t i = 0; i < n; ++i) mat.values[i] = set.material[i];
-  out.push_back(std::move(mat));
-  return out;
 }
 
 std::string duration_text(double seconds) {
@@ -194,17 +61,20 @@ int run_dim(const RunOptions& opt, const CaseDocument& doc) {
              << doc.table << "\n";
   }
 
-  StaggeredSolver<Dim> solver(setup);
+  Simulation<Dim> solver(setup);
   const double setup_seconds = std::chrono::duration<double>(Clock::now() - t_setup).count();
+  const io::FieldCatalogue<Dim> node_fields(solver, io::FieldCatalogue<Dim>::Set::nodes);
+  const io::FieldCatalogue<Dim> stress_point_fields(solver, io::FieldCatalogue<Dim>::Set::stress_points);
+  const PorePressureStage<Dim>* pressure = solver.scheme().template find<PorePressureStage<Dim>>();
 
   // Probes: the nearest node; a probe outside the body is an input error.
   struct Probe {
     std::string name;
     Index node;
-    std::vector<std::pair<std::string, FieldRef>> fields;
+    std::vector<std::pair<std::string, io::ScalarField>> fields;
   };
   std::vector<Probe> probes;
-  const auto& nodes = solver.particles().nodes;
+  const auto& nodes = solver.nodes();
   for (const ProbeSpec& spec : setup.probes) {
     Vec<Dim> x;
     for (int d = 0; d < Dim; ++d) x[d] = spec.position[static_cast<std::size_t>(d)];
@@ -223,7 +93,14 @@ int run_dim(const RunOptions& opt, const CaseDocument& doc) {
                                    spec.where, spec.name, fmt::join(spec.position, ", "), best_d));
     }
     Probe p{spec.name, best, {}};
-    for (const auto& f : spec.fields) p.fields.emplace_back(f, parse_field<Dim>(f, solver, spec));
+    for (const auto& f : spec.fields) {
+      auto value = node_fields.scalar(f);
+      if (!value) {
+        throw InputError(fmt::format("{}, key 'probe.fields': unknown field '{}' for probe '{}' (available: {})",
+                                     spec.where, f, spec.name, fmt::join(node_fields.scalar_names(), ", ")));
+      }
+      p.fields.emplace_back(f, std::move(*value));
+    }
     probes.push_back(std::move(p));
   }
 
@@ -236,7 +113,7 @@ int run_dim(const RunOptions& opt, const CaseDocument& doc) {
   auto record_probes = [&] {
     probe_csv << fmt::format("{:.10g}", solver.time());
     for (const auto& p : probes) {
-      for (const auto& [fname, ref] : p.fields) probe_csv << fmt::format(",{:.10g}", node_field<Dim>(solver, p.node, ref));
+      for (const auto& [fname, value] : p.fields) probe_csv << fmt::format(",{:.10g}", value(p.node));
     }
     probe_csv << "\n";
   };
@@ -253,15 +130,15 @@ int run_dim(const RunOptions& opt, const CaseDocument& doc) {
   io::PvdCollection node_pvd((out / "nodes.pvd").string());
   io::PvdCollection elem_pvd((out / "elements.pvd").string());
   int frame = 0;
-  const auto node_points = padded_points<Dim>(solver.particles().nodes.position);
-  const auto elem_points = padded_points<Dim>(solver.particles().elements.position);
+  const auto node_points = padded_points<Dim>(solver.nodes().position);
+  const auto elem_points = padded_points<Dim>(solver.stress_points().position);
   auto write_frame = [&] {
     const std::string name = fmt::format("nodes_{:06d}.vtu", frame);  // NOLINT
-    io::write_vtu((out / "vtu" / name).string(), node_points, set_fields<Dim>(solver, true));
+    io::write_vtu((out / "vtu" / name).string(), node_points, node_fields.extract());
     node_pvd.add(solver.time(), "vtu/" + name);
     if (setup.output_elements) {
       const std::string ename = fmt::format("elements_{:06d}.vtu", frame);
-      io::write_vtu((out / "vtu" / ename).string(), elem_points, set_fields<Dim>(solver, false));
+      io::write_vtu((out / "vtu" / ename).string(), elem_points, stress_point_fields.extract());
       elem_pvd.add(solver.time(), "vtu/" + ename);
     }
     ++frame;
@@ -275,17 +152,17 @@ int run_dim(const RunOptions& opt, const CaseDocument& doc) {
     std::cerr << fmt::format(
         "rktsph {}: {} ({}D, {} nodes, {} stress points, dt = {:.4g} s, C = {:.3f}, {} steps, "
         "{} thread{})\n",
-        kVersion, opt.case_file, Dim, solver.particles().nodes.size(),
-        solver.particles().elements.size(), dt, solver.cfl(), total_steps,
-        omp_get_max_threads(), omp_get_max_threads() > 1 ? "s" : "");
-    if (solver.saturated() && solver.impermeable_stress_face_nodes() > 0 &&
-        solver.undrained_courant() > StaggeredSolver<Dim>::kUndrainedCourantLimit) {
+        kVersion, opt.case_file, Dim, solver.nodes().size(), solver.stress_points().size(), dt, solver.cfl(),
+        total_steps, omp_get_max_threads(), omp_get_max_threads() > 1 ? "s" : "");
+    if (pressure != nullptr && pressure->impermeable_stress_face_nodes() > 0 &&
+        pressure->undrained_courant() > PorePressureStage<Dim>::kUndrainedCourantLimit) {
       std::cerr << fmt::format(
           "warning: {} boundary nodes are on impermeable faces that carry a total stress (or are free), and the "
           "undrained Courant number C c_u/c_d = {:.2f} exceeds {}, above which such faces have been measured "
           "unstable; time.cfl <= {:.3f} keeps it below (docs/VALIDATION.md, Case 16)\n",
-          solver.impermeable_stress_face_nodes(), solver.undrained_courant(), StaggeredSolver<Dim>::kUndrainedCourantLimit,
-          solver.cfl() * StaggeredSolver<Dim>::kUndrainedCourantLimit / solver.undrained_courant());
+          pressure->impermeable_stress_face_nodes(), pressure->undrained_courant(),
+          PorePressureStage<Dim>::kUndrainedCourantLimit,
+          solver.cfl() * PorePressureStage<Dim>::kUndrainedCourantLimit / pressure->undrained_courant());
     }
     if (solver.degenerate_operator_rows() > 0) {
       std::cerr << fmt::format("warning: {} particles have too few neighbours for the corrected "
@@ -347,7 +224,7 @@ int run_dim(const RunOptions& opt, const CaseDocument& doc) {
   probe_csv.flush();
   energy_csv.flush();
 
-  const double nodes_count = static_cast<double>(solver.particles().nodes.size());
+  const double nodes_count = static_cast<double>(solver.nodes().size());
   const double node_steps = nodes_count * static_cast<double>(solver.step_count());
   const int threads = omp_get_max_threads();
   const EnergyBalance e = solver.energy();
@@ -359,8 +236,8 @@ int run_dim(const RunOptions& opt, const CaseDocument& doc) {
       {"version", kVersion},
       {"git_revision", kGitRevision},
       {"dimension", Dim},
-      {"nodes", solver.particles().nodes.size()},
-      {"stress_points", solver.particles().elements.size()},
+      {"nodes", solver.nodes().size()},
+      {"stress_points", solver.stress_points().size()},
       {"spacing", setup.dx},
       {"smoothing_length", setup.h_over_dx * setup.dx},
       {"max_wave_speed", solver.max_wave_speed()},
@@ -385,33 +262,35 @@ int run_dim(const RunOptions& opt, const CaseDocument& doc) {
       {"output_frames", frame},
   };
   // Damping switched off by the kinetic-energy test (damping.until_kinetic_ratio), or null.
-  summary["damping_off_time"] = std::isfinite(solver.damping_off_time())
-                                    ? nlohmann::json(solver.damping_off_time())
+  summary["damping_off_time"] = std::isfinite(solver.clock().damping_off_time())
+                                    ? nlohmann::json(solver.clock().damping_off_time())
                                     : nlohmann::json(nullptr);
-  summary["peak_kinetic_energy"] = solver.peak_kinetic_energy();
-  if (const PressureSolveStats* ps = solver.pressure_stats()) {
+  summary["peak_kinetic_energy"] = solver.clock().peak_kinetic_energy();
+  if (pressure != nullptr) {
+    const PressureSolveStats* ps = &pressure->stats();
     // V3: the pore-pressure solve (METHOD.md §2.4): PCG iterations, residual, time share.
     summary["pressure_solve"] = {
         {"preconditioner", setup.fluid.incomplete_cholesky ? "incomplete_cholesky" : "jacobi"},
         {"tolerance", setup.fluid.tolerance},
-        {"unknowns", solver.pressure_solver()->unknowns()},
+        {"unknowns", pressure->solver().unknowns()},
         {"solves", ps->solves},
         {"iterations_max", ps->max_iterations},
         {"iterations_mean", ps->mean_iterations()},
         {"final_residual", ps->last_error},
         {"max_residual", ps->max_error},
         {"solve_seconds", ps->seconds},
-        {"pressure_step_seconds", solver.pressure_step_seconds()},
-        {"share_of_loop_time", loop_seconds > 0 ? solver.pressure_step_seconds() / loop_seconds : 0.0},
+        {"pressure_step_seconds", pressure->seconds()},
+        {"share_of_loop_time", loop_seconds > 0 ? pressure->seconds() / loop_seconds : 0.0},
     };
   }
   std::ofstream(out / "summary.json") << summary.dump(2) << "\n";
   if (!opt.quiet) {
-    if (const PressureSolveStats* ps = solver.pressure_stats()) {
+    if (pressure != nullptr) {
+      const PressureSolveStats* ps = &pressure->stats();
       std::cerr << fmt::format("pore pressure: {} PCG solves, iterations mean {:.1f} / max {}, final relative "
                                "residual {:.2e}; pressure step {:.0f} % of the loop time\n",
                                ps->solves, ps->mean_iterations(), ps->max_iterations, ps->last_error,
-                               loop_seconds > 0 ? 100.0 * solver.pressure_step_seconds() / loop_seconds : 0.0);
+                               loop_seconds > 0 ? 100.0 * pressure->seconds() / loop_seconds : 0.0);
     }
     if (exit_code == 0) {
       std::cerr << fmt::format("done: {} steps in {:.2f} s ({:.3g} node-steps/s); output in {}\n",

@@ -1,12 +1,9 @@
 #pragma once
-// Time functions that scale loads, prescribed values and body forces (METHOD.md §4.1).
+// Time functions that scale loads, prescribed values and body forces (method-notes §4.1).
 #include <string>
 #include <vector>
 
 namespace rktsph {
-namespace io {
-class Section;
-}
 
 class TimeFunction {
  public:
@@ -16,8 +13,6 @@ class TimeFunction {
   double operator()(double t) const;
 
   static TimeFunction constant(double value = 1.0);
-  /// Read one [functions.NAME] table; errors name file, line and key.
-  static TimeFunction read(const io::Section& section);
 
   Kind kind = Kind::constant;
   double value = 1.0;       // constant level (all kinds scale by it)

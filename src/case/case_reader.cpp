@@ -8,16 +8,17 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include "case/case_setup.hpp"
+#include "case/case_reader.hpp"
+#include "case/material_reader.hpp"
 #include "core/error.hpp"
 #include "io/section.hpp"
+#include "materials/uniaxial_stress.hpp"
+#include "schemes/registry.hpp"
+#include "schemes/time_step.hpp"
 
 namespace rktsph {
 
 namespace {
-
-// Largest Courant number accepted, as in StaggeredSolver (METHOD.md §0.3 item 4).
-constexpr double kMaxCourant = 1.3;
 
 std::vector<std::string> split(const std::string& s, char sep) {
   std::vector<std::string> out;
@@ -175,7 +176,7 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
   if (auto fs = root.optional_table("functions")) {
     for (const std::string& name : fs->keys()) {
       c.function_names.push_back(name);
-      c.functions.push_back(TimeFunction::read(fs->table(name)));
+      c.functions.push_back(read_time_function(fs->table(name)));
     }
     fs->finish();
   }
@@ -188,14 +189,14 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
   if (single) {
     const io::Section m = root.table("material");
     c.material_names.push_back("material");
-    c.materials.push_back(create_material(m));
+    c.materials.push_back(read_material(m));
     m.finish();
   } else {
     const io::Section ms = root.table("materials");
     for (const std::string& name : ms.keys()) {
       const io::Section m = ms.table(name);
       c.material_names.push_back(name);
-      c.materials.push_back(create_material(m));
+      c.materials.push_back(read_material(m));
       m.finish();
     }
     ms.finish();
@@ -207,7 +208,7 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     g.integer("dimension");
     c.dx = g.positive("spacing");
     if (g.has("condition")) {
-      // CASES.md §1.1 / Case 2: a 1D bar in uniaxial strain (default) or uniaxial stress.
+      // docs/cases.md §1.1 / Case 2: a 1D bar in uniaxial strain (default) or uniaxial stress.
       const std::string cond = g.string("condition");
       if (Dim != 1) g.fail("condition", "only a 1D case takes a lateral condition (2D is plane strain)");
       if (cond == "uniaxial_strain") c.condition = BarCondition::uniaxial_strain;
@@ -230,6 +231,11 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
       c.blocks.push_back(blk);
     }
     g.finish();
+  }
+  if (Dim == 1 && c.condition == BarCondition::uniaxial_stress) {
+    // docs/cases.md Case 2: scalar sigma with zero lateral stresses; the wrapper gives the
+    // elastic rate (lambda = 0, 2G = E), the bar speed and the source at (sxx, 0, 0).
+    for (auto& m : c.materials) m = std::make_shared<UniaxialStressMaterial>(m);
   }
 
   // ---- kernel
@@ -378,33 +384,26 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
       c.cfl = t.positive("cfl", 0.5);
       t.number("dt", 0.0);
     }
-    // METHOD.md §0.3 item 4: reject C > kMaxCourant here, where the key's line is known (the
-    // solver checks again for setups built in code, without a line).
-    // Same wave speed as StaggeredSolver: the bar speed sqrt(E/rho) in 1D uniaxial stress.
-    double c_max = 0.0;
-    for (const auto& m : c.materials) {
-      const bool bar = Dim == 1 && c.condition == BarCondition::uniaxial_stress;
-      c_max = std::max(c_max, bar ? std::sqrt(m->elastic().E / m->density()) : m->elastic().p_wave_speed());
-    }
-    const double courant = has_dt ? *c.dt * c_max / c.dx : *c.cfl;
-    if (courant > kMaxCourant) {
+    // method-notes §0.3 item 4: reject C > kMaxCourant here, where the key's line is known (the
+    // schemes check again for setups built in code, without a line).
+    const TimeStep step = time_step_from(c.dx, max_wave_speed(c.materials), c.cfl, c.dt);
+    if (step.courant > kMaxCourant) {
       t.fail(has_dt ? "dt" : "cfl",
              fmt::format("the Courant number c dt/dx = {:.3f} exceeds {} (c = {:.4g} m/s, dx = {} "
-                         "m); the scheme is unstable beyond it (METHOD.md §0.3 item 4)",
-                         courant, kMaxCourant, c_max, c.dx));
+                         "m); the scheme is unstable beyond it (method-notes §0.3 item 4)",
+                         step.courant, kMaxCourant, step.wave_speed, c.dx));
     }
     t.finish();
   }
 
   // ---- solver
   if (auto s = root.optional_table("solver")) {
-    const std::string version = s->string("version", "v1");
-    if (version == "v3") {
-      c.saturated = true;  // the v-p_w model (METHOD.md §1.4, §2.4, §5.3)
-    } else if (version != "v1") {
-      s->fail("version", fmt::format("unknown solver version '{}' (available: v1, v3)", version));
+    c.version = s->string("version", "v1");
+    const auto known = scheme_names<Dim>();
+    if (std::find(known.begin(), known.end(), c.version) == known.end()) {
+      s->fail("version", fmt::format("unknown solver version '{}' (available: {})", c.version, fmt::join(known, ", ")));
     }
-    // V3 pressure solve (METHOD.md §2.4 "Solver"); read for every version, used by v3 only.
+    // V3 pressure solve (method-notes §2.4 "Solver"); read for every version, used by v3 only.
     const std::string pc = s->string("pressure_preconditioner", "jacobi");
     if (pc == "jacobi") c.fluid.incomplete_cholesky = false;
     else if (pc == "incomplete_cholesky") c.fluid.incomplete_cholesky = true;
@@ -428,8 +427,8 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     s->require(c.fluid.filter >= 0.0 && c.fluid.filter <= 10.0, "pressure_filter",
                fmt::format("must lie in [0, 10] (a multiple of S_w dt/rho), got {}", c.fluid.filter));
     const std::string scheme = s->string("scheme", "staggered");
-    if (scheme == "staggered") c.scheme = Scheme::staggered;
-    else if (scheme == "collocated") c.scheme = Scheme::collocated;
+    if (scheme == "staggered") c.layout = ParticleLayout::staggered;
+    else if (scheme == "collocated") c.layout = ParticleLayout::collocated;
     else s->fail("scheme", fmt::format("unknown scheme '{}' (known: staggered, collocated)", scheme));
     c.filter = s->boolean("filter", true);
     c.filter_strength = s->number("filter_strength", 0.5);
@@ -443,8 +442,9 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
   }
 
   // ---- V3: the pore fluid (docs/case-format.md, "Saturated soil (V3)")
+  const bool saturated = find_scheme<Dim>(c.version)->pore_fluid;
   if (auto f = root.optional_table("fluid")) {
-    if (!c.saturated) f->fail("porosity", "a [fluid] table needs solver.version = \"v3\"");
+    if (!saturated) f->fail("porosity", "a [fluid] table needs solver.version = \"v3\"");
     FluidSpec& fl = c.fluid;
     fl.porosity = f->positive("porosity");
     f->require(fl.porosity < 1.0, "porosity", fmt::format("must lie in (0, 1), got {}", fl.porosity));
@@ -468,11 +468,11 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
                              c.material_names[m], rho, fl.porosity, fl.density, rho_s));
     }
     f->finish();
-  } else if (c.saturated) {
+  } else if (saturated) {
     root.fail("fluid", "missing: solver.version = \"v3\" needs a [fluid] table");
   }
   for (const auto& b : c.boundaries) {
-    if (!c.saturated && (b.pore_pressure || b.impermeable)) {
+    if (!saturated && (b.pore_pressure || b.impermeable)) {
       throw InputError(fmt::format("{}: pore_pressure / impermeable need solver.version = \"v3\"", b.where));
     }
   }
@@ -509,6 +509,46 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
   }
   root.finish();
   return c;
+}
+
+TimeFunction read_time_function(const io::Section& s) {
+  TimeFunction f;
+  const std::string type = s.string("type");
+  f.value = s.number("scale", 1.0);
+  if (type == "constant") {
+    f.kind = TimeFunction::Kind::constant;
+  } else if (type == "step") {
+    f.kind = TimeFunction::Kind::step;
+    f.start = s.non_negative("start", 0.0);
+  } else if (type == "ramp" || type == "smoothstep") {
+    f.kind = type == "ramp" ? TimeFunction::Kind::ramp : TimeFunction::Kind::smoothstep;
+    f.start = s.non_negative("start", 0.0);
+    f.duration = s.positive("duration");
+  } else if (type == "sine") {
+    f.kind = TimeFunction::Kind::sine;
+    f.offset = s.number("offset", 0.0);
+    f.amplitude = s.number("amplitude", 1.0);
+    f.frequency = s.positive("frequency");
+    f.phase = s.number("phase", 0.0);
+    f.rise_time = s.non_negative("rise_time", 0.0);
+  } else if (type == "table") {
+    f.kind = TimeFunction::Kind::table;
+    f.times = s.numbers("times");
+    f.values = s.numbers("values");
+    s.require(!f.times.empty(), "times", "needs at least one point");
+    s.require(f.times.size() == f.values.size(), "values",
+              fmt::format("must have as many entries as 'times' ({}), got {}", f.times.size(),
+                          f.values.size()));
+    for (std::size_t i = 1; i < f.times.size(); ++i) {
+      s.require(f.times[i] > f.times[i - 1], "times", "must be strictly increasing");
+    }
+  } else {
+    s.fail("type", fmt::format("unknown time function type '{}' (known: constant, step, ramp, "
+                               "smoothstep, sine, table)",
+                               type));
+  }
+  s.finish();
+  return f;
 }
 
 template CaseSetup<1> read_case<1>(const CaseDocument&);

@@ -1,18 +1,16 @@
 #pragma once
-// A case as the solver sees it, after the TOML file has been read and checked
-// (case/case_reader.cpp). Every key is documented in docs/case-format.md.
-#include <map>
+// A case as the schemes see it: plain data, made by the case-file reader (case/case_reader.hpp,
+// which alone knows TOML) or in code (case/case_builder.hpp). Every key is documented in
+// docs/case-format.md.
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include <toml++/toml.h>
-
 #include "bc/time_function.hpp"
 #include "core/types.hpp"
-#include "geometry/particles.hpp"
 #include "materials/material.hpp"
+#include "particles/lattice.hpp"
 
 namespace rktsph {
 
@@ -38,7 +36,7 @@ struct BoundarySpec {
   std::vector<std::pair<int, double>> velocity;  // (axis, m/s)
   std::vector<std::pair<int, double>> stress;    // (stress slot, Pa)
   int function = -1;                              // index into CaseSetup::functions, -1 = 1
-  // V3 (saturated) pore-pressure conditions, METHOD.md §4.1: a drained face (p_w prescribed,
+  // V3 (saturated) pore-pressure conditions, method-notes §4.1: a drained face (p_w prescribed,
   // Pa, scaled by `function`) or an explicitly impermeable one (dp_w/dn = 0, the default).
   std::optional<double> pore_pressure;
   bool impermeable = false;
@@ -64,13 +62,13 @@ struct FluidSpec {
   bool incremental = true;
   /// solver.pressure_divergence = "stress_points": the storage equation takes div of the stress
   /// points' pressure-free half-step velocity, with the stabilisation S_w (dt/2)/rho (source-free
-  /// when the stress points are at rest; see StaggeredSolver::pressure_step).
+  /// when the stress points are at rest; method-notes §2.4).
   bool divergence_from_stress_points = false;
   /// solver.pressure_filter: coefficient of the linear-exact pressure filter, in units of the
-  /// fractional-step stabilisation S_w dt/rho (0 = none; see StaggeredSolver::build_saturated).
+  /// fractional-step stabilisation S_w dt/rho (0 = none; method-notes §2.4).
   double filter = 0.5;
   double initial_pore_pressure = 0.0;    // Pa, uniform
-  /// 1/Q* = S_w n / K_f + (1 - n)/K_s (METHOD.md §1.4), 1/Pa
+  /// 1/Q* = S_w n / K_f + (1 - n)/K_s (method-notes §1.4), 1/Pa
   double inverse_storage() const {
     return saturation * porosity / bulk_modulus + (grain_bulk_modulus > 0.0 ? (1.0 - porosity) / grain_bulk_modulus : 0.0);
   }
@@ -86,18 +84,19 @@ struct ProbeSpec {
 };
 
 enum class InitialStressKind { zero, geostatic, uniform };
-/// 1D only: the lateral condition of the bar (CASES.md §1.1, Case 2).
+/// 1D only: the lateral condition of the bar (docs/cases.md §1.1, Case 2).
 enum class BarCondition { uniaxial_strain, uniaxial_stress };
-enum class Scheme { staggered, collocated };
+/// solver.scheme: two interleaved sets (the method), or one set holding both states (a comparison).
+enum class ParticleLayout { staggered, collocated };
 
 template <int Dim>
 struct CaseSetup {
   std::string file;
   std::string title;
 
-  // materials
+  // materials (a 1D bar in uniaxial stress has them wrapped in UniaxialStressMaterial)
   std::vector<std::string> material_names;
-  std::vector<std::unique_ptr<Material>> materials;
+  std::vector<std::shared_ptr<const Material>> materials;
 
   // geometry
   double dx = 0.0;
@@ -113,7 +112,7 @@ struct CaseSetup {
   // loads
   Vec<Dim> gravity = Vec<Dim>::Zero();  // m/s^2
   int gravity_function = -1;
-  double damping = 0.0;        // 1/s, velocity damping source -c_d v (METHOD.md §4.2)
+  double damping = 0.0;        // 1/s, velocity damping source -c_d v (method-notes §4.2)
   double damping_until = 0.0;  // s: damping switched off from this time on
   /// s: damping also switched off once the kinetic energy has fallen below this fraction of
   /// its peak (0 = never), tested from damping_ratio_from on (e.g. the end of a gravity ramp)
@@ -135,8 +134,10 @@ struct CaseSetup {
   std::optional<double> dt;
 
   // solver
-  Scheme scheme = Scheme::staggered;
-  bool saturated = false;  // solver.version = "v3": the v-p_w model (METHOD.md §1.4, §5.3)
+  /// The scheme, by its registry name (solver.version): "v1" dry, "v3" saturated (the v-p_w
+  /// model, method-notes §1.4, §5.3); schemes/registry.hpp lists them.
+  std::string version = "v1";
+  ParticleLayout layout = ParticleLayout::staggered;  // solver.scheme
   FluidSpec fluid;
   bool filter = true;
   double filter_strength = 0.5;
@@ -155,19 +156,5 @@ struct CaseSetup {
     return index < 0 ? 1.0 : functions[static_cast<std::size_t>(index)](t);
   }
 };
-
-/// A TOML case file, parsed, with the command-line overrides (--set key=value) applied.
-struct CaseDocument {
-  std::string file;
-  std::shared_ptr<const std::string> file_label;
-  toml::table table;
-};
-
-CaseDocument load_case_document(const std::string& file, const std::vector<std::string>& overrides);
-/// The dimension of space of a case (geometry.dimension), checked.
-int case_dimension(const CaseDocument& doc);
-
-template <int Dim>
-CaseSetup<Dim> read_case(const CaseDocument& doc);
 
 }  // namespace rktsph

@@ -1,7 +1,7 @@
 #pragma once
 // Basic types shared by every part of the solver core.
 //
-// Conventions (METHOD.md §1.1): SI units, stress positive in tension, p = -tr(sigma)/3
+// Conventions (method-notes §1.1): SI units, stress positive in tension, p = -tr(sigma)/3
 // positive in compression. The stress tensor is always carried in full: the out-of-plane
 // normal component szz in plane strain and the lateral components syy, szz in 1D uniaxial
 // strain are state variables, never dropped.
@@ -49,6 +49,16 @@ constexpr int stress_slot(StressComponent c) {
   if constexpr (Dim == 1) return -1;
   if constexpr (Dim == 2) return i == 3 ? 3 : -1;
   return i;
+}
+
+/// Slot of the tensor component (k, d) (axes k, d < Dim) in the per-dimension stress storage.
+template <int Dim>
+constexpr int stress_slot(int k, int d) {
+  if (k == d) return k;
+  const int lo = k < d ? k : d, hi = k < d ? d : k;
+  if (lo == 0 && hi == 1) return 3;
+  if (lo == 1 && hi == 2) return 4;
+  return 5;
 }
 
 /// Expand the per-dimension stress storage into the full 3D Voigt form.

@@ -6,7 +6,6 @@
 #include <fmt/format.h>
 
 #include "core/error.hpp"
-#include "io/section.hpp"
 #include "materials/source_integrator.hpp"
 
 namespace rktsph {
@@ -53,17 +52,6 @@ SourceStats Material::advance_source(double tau, const SourceBatch& b) const {
       tau, b, state_size(),
       [this](const Sym6& s, const double* k, Sym6& ds, double* dk) { source_rate(s, k, ds, dk); },
       [this](const Sym6& s, const double* k) { return relaxation_rate(s, k); });
-}
-
-ElasticConstants read_elastic_constants(const io::Section& s) {
-  const double E = s.number("E");
-  s.require(E > 0.0, "E", fmt::format("Young's modulus must be > 0 Pa, got {}", E));
-  const double nu = s.number("nu");
-  s.require(nu > -1.0 && nu < 0.5, "nu",
-            fmt::format("Poisson's ratio must lie in (-1, 0.5), got {}", nu));
-  const double rho = s.number("density");
-  s.require(rho > 0.0, "density", fmt::format("density must be > 0 kg/m^3, got {}", rho));
-  return ElasticConstants::from_E_nu(E, nu, rho);
 }
 
 }  // namespace rktsph

@@ -1,22 +1,37 @@
 #pragma once
-// Registry makers of the Perzyna models (keys documented in docs/materials.md). They read
-// their keys from the material table but do not call finish(): the caller owns the table.
+// The Perzyna models, built from plain parameter structs (the keys that fill them are in
+// docs/materials.md and are read by case/material_reader.cpp).
 #include <memory>
 
 #include "materials/material.hpp"
 #include "materials/overstress.hpp"
 
 namespace rktsph {
-namespace io {
-class Section;
-}
 
-/// fluidity-free part of the Perzyna keys: overstress, exponent, dead_band.
-Overstress read_overstress(const io::Section& section);
+/// perzyna_von_mises (method-notes §1.7): Y = max(Y0 + H eps_vp_eq, Y_residual).
+struct VonMisesParameters {
+  ElasticConstants elastic;
+  double yield_stress = 0.0;           // Y0, Pa (docs/cases.md §1.2 C2: sqrt(3) c for a cohesion c)
+  double hardening_modulus = 0.0;      // H, Pa (negative: softening)
+  double residual_yield_stress = 0.0;  // floor of Y, Pa
+  double fluidity = 0.0;               // gamma, 1/s
+  Overstress overstress;
+};
+std::unique_ptr<Material> make_perzyna_von_mises(const VonMisesParameters& parameters);
 
-/// perzyna_von_mises: METHOD.md §1.7, CASES.md §1.2 C2.
-std::unique_ptr<Material> make_perzyna_von_mises(const io::Section& section);
-/// perzyna_cam_clay: METHOD.md §1.8, CASES.md §1.2 C3.
-std::unique_ptr<Material> make_perzyna_cam_clay(const io::Section& section);
+/// perzyna_cam_clay (method-notes §1.8): modified Cam-Clay with p_c hardening.
+struct CamClayParameters {
+  ElasticConstants elastic;
+  double M = 1.0;                  // critical-state slope in triaxial compression
+  bool lode_dependent_M = false;   // M(theta) instead of constant M
+  double lambda = 0.0;             // virgin compression slope
+  double kappa = 0.0;              // swelling slope
+  double e0 = 0.0;                 // initial void ratio
+  double p_c0 = 0.0;               // Pa; used when > 0
+  double ocr = 0.0;                // used when p_c0 = 0: p_c0 = ocr x the size of the initial stress
+  double fluidity = 0.0;           // gamma, 1/s
+  Overstress overstress;
+};
+std::unique_ptr<Material> make_perzyna_cam_clay(const CamClayParameters& parameters);
 
 }  // namespace rktsph

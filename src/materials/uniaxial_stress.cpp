@@ -1,11 +1,14 @@
 #include "materials/uniaxial_stress.hpp"
 
+#include <cmath>
 #include <utility>
 
 namespace rktsph {
 
-UniaxialStressMaterial::UniaxialStressMaterial(std::unique_ptr<Material> inner)
+UniaxialStressMaterial::UniaxialStressMaterial(std::shared_ptr<const Material> inner)
     : Material(inner->elastic()), inner_(std::move(inner)) {}
+
+double UniaxialStressMaterial::wave_speed() const { return std::sqrt(elastic().E / density()); }
 
 void UniaxialStressMaterial::initial_state(const Sym6& sigma, double* state) const {
   inner_->initial_state(uniaxial(sigma), state);

@@ -9,6 +9,8 @@
 
 #include <Eigen/Dense>
 
+#include "core/error.hpp"
+#include "core/execution.hpp"
 #include "neighbours/cell_list.hpp"
 
 namespace rktsph {
@@ -22,14 +24,16 @@ struct Pair {
   double r;
 };
 
+// The pairs of row a of a relation (sources in row order), with x_a - x_b and the distance.
 template <int Dim>
-std::vector<Pair<Dim>> sorted_neighbours(const CellList<Dim>& cells, const Vec<Dim>& x) {
-  std::vector<Pair<Dim>> pairs;
-  cells.for_each_neighbour(x, [&](Index b, const Vec<Dim>& x_ab, double r) {
-    pairs.push_back({b, x_ab, r});
-  });
-  std::sort(pairs.begin(), pairs.end(), [](const auto& p, const auto& q) { return p.b < q.b; });
-  return pairs;
+void row_pairs(const Relation<Dim>& relation, Index a, const Vec<Dim>& xa, const ParticleSet<Dim>& sources,
+               std::vector<Pair<Dim>>& pairs) {
+  const auto row = relation.row(a);
+  pairs.resize(row.size());
+  for (std::size_t k = 0; k < row.size(); ++k) {
+    const Vec<Dim> x_ab = xa - sources.position[static_cast<std::size_t>(row[k])];
+    pairs[k] = {row[k], x_ab, std::sqrt(x_ab.squaredNorm())};
+  }
 }
 
 // Rows are assembled in fixed blocks: each block finds its own patterns (in parallel), then the
@@ -54,26 +58,10 @@ inline std::uint64_t hash_mix(std::uint64_t h, std::uint64_t v) {
 template <int Dim>
 struct RowGeometry {
   static constexpr std::size_t G = Dim + 1;  // doubles of geometry per pair
-  std::vector<typename CellList<Dim>::Hit> hits;
-  std::vector<std::uint64_t> order;
   std::vector<Pair<Dim>> pairs;
   std::vector<Index> offset;
   std::vector<double> geometry;
   std::uint64_t key = 0;
-
-  // The sources of target x within r_max, sorted by index. Sorting packed (index, slot) keys
-  // moves 8 bytes per swap instead of a whole pair.
-  void gather(const CellList<Dim>& cells, const Vec<Dim>& x, double r_max) {
-    const std::size_t n = cells.collect(x, r_max * r_max, hits);
-    order.resize(n);
-    for (std::size_t i = 0; i < n; ++i) order[i] = (static_cast<std::uint64_t>(hits[i].j) << 24) | i;
-    std::sort(order.begin(), order.end());
-    pairs.resize(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      const auto& hit = hits[order[i] & 0xffffffu];
-      pairs[i] = {hit.j, hit.x_ij, std::sqrt(hit.r2)};
-    }
-  }
 
   // Offsets and geometry, and a hash of the offsets, of the first source's position (rounded to
   // 2^-20 h) and of the sum of the volumes (20 bits of mantissa): coarse enough that round-off
@@ -218,16 +206,15 @@ bool row_weights(const std::vector<Pair<Dim>>& pairs, const ParticleSet<Dim>& so
 }  // namespace
 
 template <int Dim>
-CorrectedOperator<Dim> build_corrected_operator(const std::vector<Vec<Dim>>& targets,
-                                                const ParticleSet<Dim>& sources,
-                                                const CubicSplineKernel<Dim>& kernel,
+CorrectedOperator<Dim> build_corrected_operator(const Relation<Dim>& relation, const std::vector<Vec<Dim>>& targets,
+                                                const ParticleSet<Dim>& sources, const CubicSplineKernel<Dim>& kernel,
                                                 const OperatorOptions& options) {
   constexpr std::size_t G = Dim + 1;
   const double h = kernel.h();
-  // Half-radius cells: 30 % fewer candidates to test than radius-sized ones (2D).
-  const CellList<Dim> cells(sources.position, kernel.support_radius(), 2);
-  const double r_max = kernel.support_radius() * (1.0 - kSupportGap);
   const auto nt = static_cast<Index>(targets.size());
+  if (relation.rows() != nt || !relation.options().sorted) {
+    throw SolverError("corrected operator: the relation must have one sorted row per target");
+  }
   const bool share = options.share_patterns;
 
   // Geometry tolerances for sharing a pattern. Lattice positions origin + i dx carry round-off
@@ -245,32 +232,31 @@ CorrectedOperator<Dim> build_corrected_operator(const std::vector<Vec<Dim>>& tar
   std::vector<PatternTable<Dim>> local(static_cast<std::size_t>(nblocks));
   std::vector<Index> base(static_cast<std::size_t>(nt)), pattern(static_cast<std::size_t>(nt));
 
-#pragma omp parallel if (nt > 2048)
-  {
-    RowGeometry<Dim> row;
-    std::vector<Eigen::Matrix<double, Dim + 1, 1>> basis;
-    std::vector<double> wi;
-    std::vector<std::array<double, Dim>> wg;
-#pragma omp for schedule(dynamic)
-    for (Index blk = 0; blk < nblocks; ++blk) {
-      PatternTable<Dim>& table = local[static_cast<std::size_t>(blk)];
-      const Index end = std::min(nt, (blk + 1) * kBuildBlock);
-      for (Index a = blk * kBuildBlock; a < end; ++a) {
-        const auto au = static_cast<std::size_t>(a);
-        row.gather(cells, targets[au], r_max);
-        row.finish(sources, h);
-        const std::size_t n = row.pairs.size();
-        base[au] = n > 0 ? row.pairs[0].b : 0;
-        Index p = share ? table.find(row.key, row.offset.data(), row.geometry.data(), n, tol_x, tol_v) : -1;
-        if (p < 0) {
-          // A new geometry: its weights are computed once, here.
-          const bool ok = row_weights<Dim>(row.pairs, sources, kernel, basis, wi, wg);
-          p = table.add(row.key, row.offset.data(), row.geometry.data(), n, wi.data(), wg.data(), !ok, share);
+  exec::particle_for(
+      exec::Threads{}, nblocks,
+      [&](Index blk) {
+        RowGeometry<Dim> row;
+        std::vector<Eigen::Matrix<double, Dim + 1, 1>> basis;
+        std::vector<double> wi;
+        std::vector<std::array<double, Dim>> wg;
+        PatternTable<Dim>& table = local[static_cast<std::size_t>(blk)];
+        const Index end = std::min(nt, (blk + 1) * kBuildBlock);
+        for (Index a = blk * kBuildBlock; a < end; ++a) {
+          const auto au = static_cast<std::size_t>(a);
+          row_pairs(relation, a, targets[au], sources, row.pairs);
+          row.finish(sources, h);
+          const std::size_t n = row.pairs.size();
+          base[au] = n > 0 ? row.pairs[0].b : 0;
+          Index p = share ? table.find(row.key, row.offset.data(), row.geometry.data(), n, tol_x, tol_v) : -1;
+          if (p < 0) {
+            // A new geometry: its weights are computed once, here.
+            const bool ok = row_weights<Dim>(row.pairs, sources, kernel, basis, wi, wg);
+            p = table.add(row.key, row.offset.data(), row.geometry.data(), n, wi.data(), wg.data(), !ok, share);
+          }
+          pattern[au] = p;
         }
-        pattern[au] = p;
-      }
-    }
-  }
+      },
+      exec::Schedule::dynamic, nt);
 
   // Merge the blocks in order: a block's pattern joins the first matching pattern of the
   // blocks before it.
@@ -320,24 +306,44 @@ CorrectedOperator<Dim> build_corrected_operator(const std::vector<Vec<Dim>>& tar
 }
 
 template <int Dim>
-DifferenceGradient<Dim> build_difference_gradient(const std::vector<Vec<Dim>>& targets,
-                                                  const std::vector<Index>& which,
+RelationOptions operator_relation_options(const CubicSplineKernel<Dim>& kernel) {
+  // Half-radius cells: 30 % fewer candidates to test than radius-sized ones (2D).
+  return {kernel.support_radius() * (1.0 - kSupportGap), 2, true};
+}
+
+template <int Dim>
+CorrectedOperator<Dim> build_corrected_operator(const std::vector<Vec<Dim>>& targets, const ParticleSet<Dim>& sources,
+                                                const CubicSplineKernel<Dim>& kernel, const OperatorOptions& options) {
+  Relation<Dim> relation;
+  relation.build(targets, sources.position, operator_relation_options(kernel));
+  return build_corrected_operator(relation, targets, sources, kernel, options);
+}
+
+template <int Dim>
+RelationOptions difference_gradient_relation_options(const CubicSplineKernel<Dim>& kernel) {
+  return {kernel.support_radius(), 1, true};
+}
+
+template <int Dim>
+DifferenceGradient<Dim> build_difference_gradient(const Relation<Dim>& relation, const std::vector<Vec<Dim>>& targets,
                                                   const ParticleSet<Dim>& sources,
                                                   const CubicSplineKernel<Dim>& kernel) {
-  const CellList<Dim> cells(sources.position, kernel.support_radius());
+  if (relation.rows() != static_cast<Index>(targets.size()) || !relation.options().sorted) {
+    throw SolverError("difference gradient: the relation must have one sorted row per target");
+  }
   DifferenceGradient<Dim> g;
   g.row_start.push_back(0);
-  for (Index a : which) {
-    const Vec<Dim>& xa = targets[static_cast<std::size_t>(a)];
-    const auto pairs = sorted_neighbours(cells, xa);
+  std::vector<Pair<Dim>> pairs;
+  for (Index a = 0; a < relation.rows(); ++a) {
+    row_pairs(relation, a, targets[static_cast<std::size_t>(a)], sources, pairs);
     Mat<Dim> A = Mat<Dim>::Zero();
     for (const auto& p : pairs) {
       const double V = sources.volume[static_cast<std::size_t>(p.b)];
       A += V * kernel.gradient(p.x_ab) * (-p.x_ab).transpose();
     }
-    // METHOD.md §3.2: A_a = sum V_b grad_a W_ab (x) (x_b - x_a); fall back to the identity when
-    // it is singular.
-    // A is O(1) for a reasonable support; a tiny determinant means too few sources.
+    // method-notes §3.2: A_a = sum V_b grad_a W_ab (x) (x_b - x_a); fall back to the identity
+    // when it is singular. A is O(1) for a reasonable support; a tiny determinant means too few
+    // sources.
     const bool ok = std::abs(A.determinant()) > 1e-8;
     const Mat<Dim> Ainv = ok ? Mat<Dim>(A.inverse()) : Mat<Dim>::Identity();
     Vec<Dim> sum = Vec<Dim>::Zero();
@@ -355,13 +361,29 @@ DifferenceGradient<Dim> build_difference_gradient(const std::vector<Vec<Dim>>& t
   return g;
 }
 
-#define RKTSPH_INSTANTIATE(D)                                                                   \
-  template CorrectedOperator<D> build_corrected_operator<D>(                                    \
-      const std::vector<Vec<D>>&, const ParticleSet<D>&, const CubicSplineKernel<D>&,           \
-      const OperatorOptions&);                                                                  \
-  template DifferenceGradient<D> build_difference_gradient<D>(                                  \
-      const std::vector<Vec<D>>&, const std::vector<Index>&, const ParticleSet<D>&,            \
-      const CubicSplineKernel<D>&);
+template <int Dim>
+DifferenceGradient<Dim> build_difference_gradient(const std::vector<Vec<Dim>>& targets, const std::vector<Index>& which,
+                                                  const ParticleSet<Dim>& sources,
+                                                  const CubicSplineKernel<Dim>& kernel) {
+  std::vector<Vec<Dim>> selected;
+  for (Index a : which) selected.push_back(targets[static_cast<std::size_t>(a)]);
+  Relation<Dim> relation;
+  relation.build(selected, sources.position, difference_gradient_relation_options(kernel));
+  return build_difference_gradient(relation, selected, sources, kernel);
+}
+
+#define RKTSPH_INSTANTIATE(D)                                                                                  \
+  template RelationOptions operator_relation_options<D>(const CubicSplineKernel<D>&);                          \
+  template RelationOptions difference_gradient_relation_options<D>(const CubicSplineKernel<D>&);               \
+  template CorrectedOperator<D> build_corrected_operator<D>(const Relation<D>&, const std::vector<Vec<D>>&,      \
+                                                            const ParticleSet<D>&, const CubicSplineKernel<D>&, \
+                                                            const OperatorOptions&);                           \
+  template CorrectedOperator<D> build_corrected_operator<D>(const std::vector<Vec<D>>&, const ParticleSet<D>&,   \
+                                                            const CubicSplineKernel<D>&, const OperatorOptions&); \
+  template DifferenceGradient<D> build_difference_gradient<D>(const Relation<D>&, const std::vector<Vec<D>>&,    \
+                                                              const ParticleSet<D>&, const CubicSplineKernel<D>&); \
+  template DifferenceGradient<D> build_difference_gradient<D>(const std::vector<Vec<D>>&, const std::vector<Index>&, \
+                                                              const ParticleSet<D>&, const CubicSplineKernel<D>&);
 RKTSPH_INSTANTIATE(1)
 RKTSPH_INSTANTIATE(2)
 RKTSPH_INSTANTIATE(3)

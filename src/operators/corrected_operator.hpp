@@ -1,16 +1,18 @@
 #pragma once
-// Corrected SPH interpolation and gradient between particle sets (METHOD.md §3.2, with the
-// linear-exact (n_d+1) system that §0.3 item 2 found necessary for convergence).
+// Corrected SPH interpolation and gradient between particle sets (method-notes §3.2, with the
+// linear-exact (n_d+1) system that §0.3 item 2 found necessary for convergence), computed from
+// a neighbour relation (neighbours/relation.hpp).
 //
 // At a target point a, with sources b in the kernel support, the (n_d+1) unknowns
 // (f_a, grad f_a) solve
 //     M_a [f_a; grad f_a] = sum_b V_b [W_ab; grad_a W_ab] f_b,
 //     M_a = sum_b V_b [W_ab; grad_a W_ab] (x) [1, x_b - x_a],
 // which is exact for linear fields everywhere, including truncated supports at boundaries.
-// Particles never move in V1/V3, so the weights M_a^{-1} V_b [W_ab; grad_a W_ab] are computed
-// once and a time step is a streaming sum over them.
+// Where particles do not move (V1, V3) the weights M_a^{-1} V_b [W_ab; grad_a W_ab] are
+// computed once and a time step is a streaming sum over them; where they move, the operator is
+// rebuilt from the rebuilt relation.
 //
-// Storage: shared row patterns. The weights of a row depend only on the relative positions
+// Storage: shared row patterns, a cache for fixed particles. The weights of a row depend only on the relative positions
 // x_b - x_a and the volumes V_b of its sources. On a lattice (in lattice order) almost every row
 // is a shifted copy of a few others: the interior rows are one class, the boundary rows a few
 // classes per face, edge and corner. So each row is stored as (base source index, pattern id),
@@ -24,7 +26,8 @@
 
 #include "core/kernel.hpp"
 #include "core/types.hpp"
-#include "geometry/particles.hpp"
+#include "neighbours/relation.hpp"
+#include "particles/particle_set.hpp"
 
 namespace rktsph {
 
@@ -74,10 +77,10 @@ struct CorrectedOperator {
   }
 };
 
-/// CSPM difference-form gradient with a given value at the target (METHOD.md §3.2):
+/// CSPM difference-form gradient with a given value at the target (method-notes §3.2):
 ///   grad f_a = A_a^{-1} sum_b V_b (f_b - fhat_a) grad_a W_ab  =  sum_b c_ab f_b - (sum_b c_ab) fhat_a
 /// Used at boundary nodes where a component is prescribed, so that the prescribed value
-/// reaches the dynamics (METHOD.md §0.3 item 1, fix (a)).
+/// reaches the dynamics (method-notes §0.3 item 1, fix (a)).
 template <int Dim>
 struct DifferenceGradient {
   std::vector<Index> row_start;
@@ -93,18 +96,36 @@ struct OperatorOptions {
   bool share_patterns = true;
 };
 
-/// Build the corrected operator from `sources` to the points `targets`, for every source
-/// within the kernel support. The result does not depend on the number of threads.
+/// The relation the corrected operator is built from: sources within the support (less a
+/// relative 1e-10, see corrected_operator.cpp), rows sorted by source index.
 template <int Dim>
-CorrectedOperator<Dim> build_corrected_operator(const std::vector<Vec<Dim>>& targets,
-                                                const ParticleSet<Dim>& sources,
+RelationOptions operator_relation_options(const CubicSplineKernel<Dim>& kernel);
+/// The relation of the difference gradient: sources within the support, sorted.
+template <int Dim>
+RelationOptions difference_gradient_relation_options(const CubicSplineKernel<Dim>& kernel);
+
+/// Build the corrected operator from `sources` to the points `targets` over `relation` (built
+/// with operator_relation_options, one row per target). The result does not depend on the
+/// number of threads.
+template <int Dim>
+CorrectedOperator<Dim> build_corrected_operator(const Relation<Dim>& relation, const std::vector<Vec<Dim>>& targets,
+                                                const ParticleSet<Dim>& sources, const CubicSplineKernel<Dim>& kernel,
+                                                const OperatorOptions& options = {});
+/// The same, with the relation built here and dropped.
+template <int Dim>
+CorrectedOperator<Dim> build_corrected_operator(const std::vector<Vec<Dim>>& targets, const ParticleSet<Dim>& sources,
                                                 const CubicSplineKernel<Dim>& kernel,
                                                 const OperatorOptions& options = {});
 
-/// Build difference-form gradients at the selected targets (one row per entry of `which`).
+/// Difference-form gradients at `targets` over `relation` (built with
+/// difference_gradient_relation_options, one row per target).
 template <int Dim>
-DifferenceGradient<Dim> build_difference_gradient(const std::vector<Vec<Dim>>& targets,
-                                                  const std::vector<Index>& which,
+DifferenceGradient<Dim> build_difference_gradient(const Relation<Dim>& relation, const std::vector<Vec<Dim>>& targets,
+                                                  const ParticleSet<Dim>& sources,
+                                                  const CubicSplineKernel<Dim>& kernel);
+/// The same at the selected targets (one row per entry of `which`), with the relation built here.
+template <int Dim>
+DifferenceGradient<Dim> build_difference_gradient(const std::vector<Vec<Dim>>& targets, const std::vector<Index>& which,
                                                   const ParticleSet<Dim>& sources,
                                                   const CubicSplineKernel<Dim>& kernel);
 

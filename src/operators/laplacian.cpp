@@ -2,22 +2,36 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include <Eigen/Dense>
 
+#include "core/error.hpp"
 #include "neighbours/cell_list.hpp"
 
 namespace rktsph {
 
 template <int Dim>
-NodeLaplacian<Dim> build_node_laplacian(const ParticleSet<Dim>& nodes,
+RelationOptions laplacian_relation_options(const CubicSplineKernel<Dim>& kernel) {
+  // Rows in the cell list's visiting order (the order the sums below are formed in).
+  return {kernel.support_radius(), 1, false};
+}
+
+template <int Dim>
+NodeLaplacian<Dim> build_node_laplacian(const Relation<Dim>& relation, const ParticleSet<Dim>& nodes,
                                         const CubicSplineKernel<Dim>& kernel,
                                         const std::vector<std::uint8_t>& wall_axes,
                                         const std::vector<MirrorPlane>& mirrors,
                                         const std::vector<std::uint8_t>& mirror_mask) {
   using Triplet = Eigen::Triplet<double>;
   const auto n = static_cast<std::size_t>(nodes.size());
-  const CellList<Dim> cells(nodes.position, kernel.support_radius());
+  if (relation.rows() != nodes.size() || relation.options().sorted ||
+      relation.options().radius != kernel.support_radius()) {
+    throw SolverError("node Laplacian: the relation must be built with laplacian_relation_options");
+  }
+  // Mirror images are searched around the image points (not particles), with a cell list.
+  std::optional<CellList<Dim>> cells;
+  if (!mirrors.empty()) cells.emplace(nodes.position, kernel.support_radius());
 
   struct Pair {
     Index j;
@@ -32,9 +46,11 @@ NodeLaplacian<Dim> build_node_laplacian(const ParticleSet<Dim>& nodes,
   std::vector<Vec<Dim>> corr(n, Vec<Dim>::Zero());
   for (std::size_t i = 0; i < n; ++i) {
     const Vec<Dim>& xi = nodes.position[i];
-    cells.for_each_neighbour(xi, [&](Index j, const Vec<Dim>& x_ij, double r) {
+    for (const Index j : relation.row(static_cast<Index>(i))) {
+      const Vec<Dim> x_ij = xi - nodes.position[static_cast<std::size_t>(j)];
+      const double r = std::sqrt(x_ij.squaredNorm());
       if (static_cast<std::size_t>(j) != i && r > 0.0) pairs[i].push_back({j, x_ij, r});
-    });
+    }
     // Mirror images across the impermeable walls within reach (even extension, p_J' = p_J).
     for (std::size_t k = 0; k < mirrors.size() && k < 8; ++k) {
       if (!mirror_mask.empty() && ((mirror_mask[i] >> k) & 1u) == 0) continue;
@@ -43,7 +59,7 @@ NodeLaplacian<Dim> build_node_laplacian(const ParticleSet<Dim>& nodes,
       if (dist < -1e-9 * kernel.h() || dist >= kernel.support_radius()) continue;
       Vec<Dim> image = xi;  // the sources near the image of I are the images of I's partners
       image[m.axis] = 2.0 * m.coord - xi[m.axis];
-      cells.for_each_neighbour(image, [&](Index j, const Vec<Dim>&, double) {
+      cells->for_each_neighbour(image, [&](Index j, const Vec<Dim>&, double) {
         Vec<Dim> xj = nodes.position[static_cast<std::size_t>(j)];
         if ((m.coord - xj[m.axis]) * m.outward < -1e-9 * kernel.h()) return;  // not in this body half
         xj[m.axis] = 2.0 * m.coord - xj[m.axis];
@@ -106,12 +122,28 @@ NodeLaplacian<Dim> build_node_laplacian(const ParticleSet<Dim>& nodes,
   return out;
 }
 
-template NodeLaplacian<1> build_node_laplacian<1>(const ParticleSet<1>&, const CubicSplineKernel<1>&,
-                                                  const std::vector<std::uint8_t>&, const std::vector<MirrorPlane>&,
-                                                  const std::vector<std::uint8_t>&);
-template NodeLaplacian<2> build_node_laplacian<2>(const ParticleSet<2>&, const CubicSplineKernel<2>&,
-                                                  const std::vector<std::uint8_t>&, const std::vector<MirrorPlane>&,
-                                                  const std::vector<std::uint8_t>&);
+template <int Dim>
+NodeLaplacian<Dim> build_node_laplacian(const ParticleSet<Dim>& nodes, const CubicSplineKernel<Dim>& kernel,
+                                        const std::vector<std::uint8_t>& wall_axes,
+                                        const std::vector<MirrorPlane>& mirrors,
+                                        const std::vector<std::uint8_t>& mirror_mask) {
+  Relation<Dim> relation;
+  relation.build(nodes.position, nodes.position, laplacian_relation_options(kernel));
+  return build_node_laplacian(relation, nodes, kernel, wall_axes, mirrors, mirror_mask);
+}
+
+#define RKTSPH_INSTANTIATE(D)                                                                                    \
+  template RelationOptions laplacian_relation_options<D>(const CubicSplineKernel<D>&);                           \
+  template NodeLaplacian<D> build_node_laplacian<D>(const Relation<D>&, const ParticleSet<D>&,                   \
+                                                    const CubicSplineKernel<D>&, const std::vector<std::uint8_t>&, \
+                                                    const std::vector<MirrorPlane>&, const std::vector<std::uint8_t>&); \
+  template NodeLaplacian<D> build_node_laplacian<D>(const ParticleSet<D>&, const CubicSplineKernel<D>&,          \
+                                                    const std::vector<std::uint8_t>&, const std::vector<MirrorPlane>&, \
+                                                    const std::vector<std::uint8_t>&);
+RKTSPH_INSTANTIATE(1)
+RKTSPH_INSTANTIATE(2)
+RKTSPH_INSTANTIATE(3)
+#undef RKTSPH_INSTANTIATE
 
 template <int Dim>
 Eigen::SparseMatrix<double, Eigen::RowMajor> build_filter_gradient_part(
@@ -149,6 +181,9 @@ template Eigen::SparseMatrix<double, Eigen::RowMajor> build_filter_gradient_part
 template Eigen::SparseMatrix<double, Eigen::RowMajor> build_filter_gradient_part<2>(
     const Eigen::SparseMatrix<double, Eigen::RowMajor>&, const std::vector<Vec<2>>&,
     const std::array<Eigen::SparseMatrix<double, Eigen::RowMajor>, 2>&);
+template Eigen::SparseMatrix<double, Eigen::RowMajor> build_filter_gradient_part<3>(
+    const Eigen::SparseMatrix<double, Eigen::RowMajor>&, const std::vector<Vec<3>>&,
+    const std::array<Eigen::SparseMatrix<double, Eigen::RowMajor>, 3>&);
 
 template <int Dim>
 std::array<Eigen::SparseMatrix<double, Eigen::RowMajor>, Dim> gradient_matrices(const CorrectedOperator<Dim>& op,
@@ -172,5 +207,6 @@ std::array<Eigen::SparseMatrix<double, Eigen::RowMajor>, Dim> gradient_matrices(
 
 template std::array<Eigen::SparseMatrix<double, Eigen::RowMajor>, 1> gradient_matrices<1>(const CorrectedOperator<1>&, Index);
 template std::array<Eigen::SparseMatrix<double, Eigen::RowMajor>, 2> gradient_matrices<2>(const CorrectedOperator<2>&, Index);
+template std::array<Eigen::SparseMatrix<double, Eigen::RowMajor>, 3> gradient_matrices<3>(const CorrectedOperator<3>&, Index);
 
 }  // namespace rktsph

@@ -32,7 +32,8 @@
 
 #include "core/kernel.hpp"
 #include "core/types.hpp"
-#include "geometry/particles.hpp"
+#include "neighbours/relation.hpp"
+#include "particles/particle_set.hpp"
 #include "operators/corrected_operator.hpp"
 
 namespace rktsph {
@@ -66,6 +67,17 @@ struct NodeLaplacian {
 /// `mirror_mask[I]` (may be empty = all) selects, bit k, the planes mirrors[k] used at node I
 /// (at most 8 planes), so that a plane that is impermeable only in part (a footing on a drained
 /// surface) mirrors only where it is a wall.
+template <int Dim>
+NodeLaplacian<Dim> build_node_laplacian(const Relation<Dim>& relation, const ParticleSet<Dim>& nodes,
+                                        const CubicSplineKernel<Dim>& kernel,
+                                        const std::vector<std::uint8_t>& wall_axes = {},
+                                        const std::vector<MirrorPlane>& mirrors = {},
+                                        const std::vector<std::uint8_t>& mirror_mask = {});
+/// The relation build_node_laplacian sums over: node pairs within the support, rows in the cell
+/// list's order.
+template <int Dim>
+RelationOptions laplacian_relation_options(const CubicSplineKernel<Dim>& kernel);
+/// The same, with the relation built here.
 template <int Dim>
 NodeLaplacian<Dim> build_node_laplacian(const ParticleSet<Dim>& nodes,
                                         const CubicSplineKernel<Dim>& kernel,

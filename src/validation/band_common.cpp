@@ -9,12 +9,9 @@
 
 namespace rktsph::validation {
 
-NodeHistory::NodeHistory(const StaggeredSolver<2>& solver, const std::string& name, const std::string& who)
-    : solver_(solver), stride_(static_cast<std::size_t>(solver.history_stride())) {
-  const auto& names = solver.history_names();
-  const auto it = std::find(names.begin(), names.end(), name);
-  if (it == names.end()) throw SolverError(who + ": the material carries no " + name);
-  index_ = static_cast<std::size_t>(it - names.begin());
+HistoryView node_history(const Simulation<2>& solver, const std::string& name, const std::string& who) {
+  if (solver.history_layout().find(name) < 0) throw SolverError(who + ": the material carries no " + name);
+  return solver.node_history(name);
 }
 
 namespace {

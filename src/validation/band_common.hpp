@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "solvers/staggered_solver.hpp"
+#include "schemes/simulation.hpp"
 
 namespace rktsph::validation {
 
@@ -26,20 +26,9 @@ inline double platen_time(double strain) {
   return kPlatenRampTime + (strain * kSampleHeight - 0.5 * kPlatenSpeed * kPlatenRampTime) / kPlatenSpeed;
 }
 
-/// A nodal history variable by name (e.g. "eps_vp_eq"), read as node_history()[i]; throws
-/// SolverError naming `who` if the materials carry no such variable.
-class NodeHistory {
- public:
-  NodeHistory(const StaggeredSolver<2>& solver, const std::string& name, const std::string& who);
-  double operator()(std::size_t i) const {
-    const int slot = solver_.history_slot(solver_.particles().nodes.material[i], index_);
-    return solver_.node_history()[i * stride_ + static_cast<std::size_t>(slot)];
-  }
-
- private:
-  const StaggeredSolver<2>& solver_;
-  std::size_t index_ = 0, stride_ = 0;
-};
+/// A nodal history variable by name (e.g. "eps_vp_eq"); throws SolverError naming `who` if the
+/// materials carry no such variable.
+HistoryView node_history(const Simulation<2>& solver, const std::string& name, const std::string& who);
 
 /// The band fitted to the cloud of nodes where eps >= 50 % of its maximum inside the band
 /// region (CASES.md §1.3).

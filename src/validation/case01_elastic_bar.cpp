@@ -5,9 +5,9 @@
 
 #include <fmt/format.h>
 
-#include "case/case_setup.hpp"
+#include "case/case_reader.hpp"
 #include "core/error.hpp"
-#include "solvers/staggered_solver.hpp"
+#include "schemes/simulation.hpp"
 #include "validation/analytic.hpp"
 #include "validation/validation.hpp"
 
@@ -63,10 +63,9 @@ BarResult run_bar(const BarRun& r, const std::string& case_file, const std::vect
   if (r.collocated) set.emplace_back("solver.scheme=\"collocated\"");
   const CaseDocument doc = load_case_document(case_file, set);
   CaseSetup<1> setup = read_case<1>(doc);
-  StaggeredSolver<1> solver(setup);
+  Simulation<1> solver(setup);
   const analytic::ElasticBar exact{kL, kC, kRho, r.sign * kSigma0, rise};
-  constexpr int NV = StaggeredSolver<1>::NV;
-  const auto& nodes = solver.particles().nodes;
+  const auto& nodes = solver.nodes();
   const auto nn = static_cast<std::size_t>(nodes.size());
   std::size_t loaded = 0, fixed = 0;
   for (std::size_t i = 0; i < nn; ++i) {
@@ -80,7 +79,7 @@ BarResult run_bar(const BarRun& r, const std::string& case_file, const std::vect
     double num = 0.0, den = 0.0;
     for (std::size_t i = 0; i < nn; ++i) {
       const double ref = exact.stress(nodes.position[i][0], t);
-      num += std::abs(solver.node_phi()[i * NV + 1] - ref);
+      num += std::abs(solver.node_stress()(i, StressComponent::xx) - ref);
       den += std::abs(ref);
     }
     return den > 0.0 ? num / den : num;
@@ -101,7 +100,7 @@ BarResult run_bar(const BarRun& r, const std::string& case_file, const std::vect
     }
     const double t = solver.time();
     for (std::size_t i = 0; i < nn; ++i) {
-      out.max_abs_stress = std::max(out.max_abs_stress, std::abs(solver.node_phi()[i * NV + 1]) / kSigma0);
+      out.max_abs_stress = std::max(out.max_abs_stress, std::abs(solver.node_stress()(i, StressComponent::xx)) / kSigma0);
     }
     if (!std::isfinite(out.max_abs_stress) || out.max_abs_stress > 1e6) {
       out.blew_up = true;
@@ -113,9 +112,9 @@ BarResult run_bar(const BarRun& r, const std::string& case_file, const std::vect
       const double err = std::abs(e.imbalance()) / scale;
       out.max_energy_error = std::max(out.max_energy_error, err);
       out.t.push_back(t / kTransit);
-      out.v_loaded.push_back(solver.node_phi()[loaded * NV]);
+      out.v_loaded.push_back(solver.node_velocity()(loaded, 0));
       out.v_loaded_exact.push_back(exact.velocity(kL, t));
-      out.s_fixed.push_back(solver.node_phi()[fixed * NV + 1]);
+      out.s_fixed.push_back(solver.node_stress()(fixed, StressComponent::xx));
       out.s_fixed_exact.push_back(exact.stress(0.0, t));
       out.energy_error.push_back(e.imbalance() / scale);
       out.e1_t.push_back(e1_now(t));
@@ -126,8 +125,8 @@ BarResult run_bar(const BarRun& r, const std::string& case_file, const std::vect
       int count = 0;
       for (std::size_t i = 1; i + 1 < nn; ++i) {
         if (exact.distance_to_front(nodes.position[i][0], t) <= 3.0 * dx) continue;
-        const double s = solver.node_phi()[i * NV + 1];
-        const double zz = s - 0.5 * (solver.node_phi()[(i - 1) * NV + 1] + solver.node_phi()[(i + 1) * NV + 1]);
+        const double s = solver.node_stress()(i, StressComponent::xx);
+        const double zz = s - 0.5 * (solver.node_stress()(i - 1, StressComponent::xx) + solver.node_stress()(i + 1, StressComponent::xx));
         sum += zz * zz;
         ++count;
       }
@@ -144,7 +143,7 @@ BarResult run_bar(const BarRun& r, const std::string& case_file, const std::vect
       std::vector<double> xs, ss, es;
       for (std::size_t i = 0; i < nn; ++i) {
         xs.push_back(nodes.position[i][0]);
-        ss.push_back(solver.node_phi()[i * NV + 1]);
+        ss.push_back(solver.node_stress()(i, StressComponent::xx));
         es.push_back(exact.stress(nodes.position[i][0], t));
       }
       if (std::abs(snapshots[next_snap] - 0.5) < 1e-9 && !r.smooth) {

@@ -7,9 +7,9 @@
 
 #include <fmt/format.h>
 
-#include "case/case_setup.hpp"
+#include "case/case_reader.hpp"
 #include "core/error.hpp"
-#include "solvers/staggered_solver.hpp"
+#include "schemes/simulation.hpp"
 #include "validation/validation.hpp"
 
 namespace rktsph::validation {
@@ -72,20 +72,16 @@ BarResult run_bar(const std::string& case_file, double dx, double fluidity) {
   };
   const CaseDocument doc = load_case_document(case_file, set);
   CaseSetup<1> setup = read_case<1>(doc);
-  StaggeredSolver<1> solver(setup);
-  constexpr int NV = StaggeredSolver<1>::NV;
-  const auto& nodes = solver.particles().nodes;
+  Simulation<1> solver(setup);
+  const auto& nodes = solver.nodes();
   const auto nn = static_cast<std::size_t>(nodes.size());
-  const auto& names = solver.history_names();
-  const auto name_it = std::find(names.begin(), names.end(), "eps_vp_eq");
-  if (name_it == names.end()) throw SolverError("case 2: the material carries no eps_vp_eq");
-  const int slot = solver.history_slot(0, static_cast<std::size_t>(name_it - names.begin()));
-  const auto stride = static_cast<std::size_t>(solver.history_stride());
+  if (solver.history_layout().find("eps_vp_eq") < 0) throw SolverError("case 2: the material carries no eps_vp_eq");
+  const HistoryView eps_vp_eq = solver.node_history("eps_vp_eq");
   std::vector<std::size_t> order(nn);
   for (std::size_t i = 0; i < nn; ++i) order[i] = i;
   std::sort(order.begin(), order.end(),
             [&](std::size_t a, std::size_t b) { return nodes.position[a][0] < nodes.position[b][0]; });
-  auto eps_of = [&](std::size_t i) { return solver.node_history()[i * stride + static_cast<std::size_t>(slot)]; };
+  auto eps_of = [&](std::size_t i) { return eps_vp_eq(i); };
   auto integral_now = [&] {
     double s = 0.0;
     for (std::size_t i = 0; i < nn; ++i) s += nodes.volume[i] * eps_of(i);
@@ -102,7 +98,7 @@ BarResult run_bar(const std::string& case_file, double dx, double fluidity) {
     if (n > 0) solver.step();
     if (n % record_every == 0 || n == steps) {
       out.t.push_back(solver.time());
-      out.sigma0.push_back(solver.node_phi()[order.front() * NV + 1]);
+      out.sigma0.push_back(solver.node_stress()(order.front(), StressComponent::xx));
       out.integral_t.push_back(integral_now());
     }
     if (n == half_transit) {
@@ -114,13 +110,13 @@ BarResult run_bar(const std::string& case_file, double dx, double fluidity) {
       for (std::size_t k = 0; k < nn; ++k) {
         const std::size_t i = order[k];
         const double xi = nodes.position[i][0];
-        const double s = solver.node_phi()[i * NV + 1];
+        const double s = solver.node_stress()(i, StressComponent::xx);
         const double ref = xi > front_exact ? s_wave : 0.0;
         num += std::abs(s - ref);
         den += std::abs(ref);
         smax = std::max(smax, s);
         if (!found && k + 1 < nn) {
-          const double a = s / s_wave, b = solver.node_phi()[order[k + 1] * NV + 1] / s_wave;
+          const double a = s / s_wave, b = solver.node_stress()(order[k + 1], StressComponent::xx) / s_wave;
           if (a < 0.5 && b >= 0.5) {
             front = xi + (0.5 - a) / (b - a) * (nodes.position[order[k + 1]][0] - xi);
             found = true;
@@ -135,7 +131,7 @@ BarResult run_bar(const std::string& case_file, double dx, double fluidity) {
   out.max_substeps = solver.max_source_substeps();
   for (std::size_t i : order) {
     out.x.push_back(nodes.position[i][0]);
-    out.sigma.push_back(solver.node_phi()[i * NV + 1]);
+    out.sigma.push_back(solver.node_stress()(i, StressComponent::xx));
     out.eps.push_back(eps_of(i));
   }
   out.integral = integral_now();

@@ -8,9 +8,9 @@
 
 #include <fmt/format.h>
 
-#include "case/case_setup.hpp"
+#include "case/case_reader.hpp"
 #include "core/error.hpp"
-#include "solvers/staggered_solver.hpp"
+#include "schemes/simulation.hpp"
 #include "validation/band_common.hpp"
 #include "validation/validation.hpp"
 
@@ -89,12 +89,11 @@ SampleResult run_sample(const std::string& case_file, double dx, double end_stra
   }
   const CaseDocument doc = load_case_document(case_file, set);
   CaseSetup<2> setup = read_case<2>(doc);
-  StaggeredSolver<2> solver(setup);
-  constexpr int NV = StaggeredSolver<2>::NV;
-  const auto& nodes = solver.particles().nodes;
+  Simulation<2> solver(setup);
+  const auto& nodes = solver.nodes();
   const auto nn = static_cast<std::size_t>(nodes.size());
-  const NodeHistory eps_of(solver, "eps_vp_eq", "case 3");
-  auto q_of = [&](std::size_t i) { return invariants(to_sym6<2>(&solver.node_phi()[i * NV + 2])).q; };
+  const HistoryView eps_of = node_history(solver, "eps_vp_eq", "case 3");
+  auto q_of = [&](std::size_t i) { return solver.node_stress().invariants(i).q; };
   std::vector<std::size_t> top;
   double volume = 0.0;
   for (std::size_t i = 0; i < nn; ++i) {
@@ -120,7 +119,7 @@ SampleResult run_sample(const std::string& case_file, double dx, double end_stra
     Sym6 avg{};
     double eps_mean = 0.0;
     for (std::size_t i = 0; i < nn; ++i) {
-      const Sym6 s = to_sym6<2>(&solver.node_phi()[i * NV + 2]);
+      const Sym6 s = solver.node_stress().sym6(i);
       for (std::size_t c = 0; c < 6; ++c) avg[c] += nodes.volume[i] * s[c] / volume;
       eps_mean += nodes.volume[i] * eps_of(i) / volume;
     }
@@ -139,7 +138,7 @@ SampleResult run_sample(const std::string& case_file, double dx, double end_stra
     if (n % record_every == 0 || n == steps) {
       // Platen measure: mean of -sigma_yy over the top nodes (smooth platen, uniform face).
       double syy = 0.0;
-      for (std::size_t i : top) syy += solver.node_phi()[i * NV + 3];
+      for (std::size_t i : top) syy += solver.node_stress()(i, StressComponent::yy);
       out.strain.push_back(strain);
       out.q.push_back(inv.q);
       out.p.push_back(inv.p);
@@ -168,8 +167,8 @@ SampleResult run_sample(const std::string& case_file, double dx, double end_stra
         s.y.push_back(nodes.position[i][1]);
         s.eps.push_back(eps_of(i));
         s.q.push_back(q_of(i));
-        s.vx.push_back(solver.node_phi()[i * NV]);
-        s.vy.push_back(solver.node_phi()[i * NV + 1]);
+        s.vx.push_back(solver.node_velocity()(i, 0));
+        s.vy.push_back(solver.node_velocity()(i, 1));
       }
       out.snaps.push_back(std::move(s));
       ++next_snap;

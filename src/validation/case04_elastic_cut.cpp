@@ -178,9 +178,8 @@ CaseB run_b(const std::string& file, double dx, const std::string& dir) {
   double max_uy = 0.0, max_ux = 0.0;
   std::ofstream f(fs::path(dir) / fmt::format("b_history_dx{}.csv", dx));
   f << "t,syy_exact,syy_x1,syy_x5,syy_x9.75,uy_exact,uy_x1,uy_x5,uy_x9.75,ux_face_max\n";
-  constexpr int NV = StaggeredSolver<2>::NV;
-  auto hook = [&](const StaggeredSolver<2>& solver) {
-    const auto& nodes = solver.particles().nodes;
+  auto hook = [&](const Simulation<2>& solver) {
+    const auto& nodes = solver.nodes();
     const auto nn = static_cast<std::size_t>(nodes.size());
     if (!init) {
       for (int k = 0; k < 3; ++k) {
@@ -208,22 +207,22 @@ CaseB run_b(const std::string& file, double dx, const std::string& dir) {
     const bool near_rev = std::abs(t - rev * std::round(t / rev)) <= 2.0 * solver.dt() + 1e-12;
     double sv[3], uv[3];
     for (std::size_t k = 0; k < 3; ++k) {
-      sv[k] = solver.node_phi()[base[k] * NV + 3];
-      uv[k] = solver.node_displacement()[top[k] * 2 + 1];
+      sv[k] = solver.node_stress()(base[k], StressComponent::yy);
+      uv[k] = solver.node_displacement()(top[k], 1);
       if (!near_rev) b.base_err = std::max(b.base_err, std::abs(sv[k] - se) / (2.0 * kGammaH));
       b.top_err = std::max(b.top_err, std::abs(uv[k] - ue) / (kGammaH * kH / kE));
     }
     double ux = 0.0;
-    for (std::size_t i : face) ux = std::max(ux, std::abs(solver.node_displacement()[2 * i]));
+    for (std::size_t i : face) ux = std::max(ux, std::abs(solver.node_displacement()(i, 0)));
     for (std::size_t i = 0; i < static_cast<std::size_t>(nodes.size()); ++i) {
-      max_uy = std::max(max_uy, std::abs(solver.node_displacement()[2 * i + 1]));
+      max_uy = std::max(max_uy, std::abs(solver.node_displacement()(i, 1)));
     }
     max_ux = std::max(max_ux, ux);
     for (const auto& row : rows) {
       double lo = 1e300, hi = -1e300;
       for (std::size_t i : row) {
-        lo = std::min(lo, solver.node_phi()[i * NV + 3]);
-        hi = std::max(hi, solver.node_phi()[i * NV + 3]);
+        lo = std::min(lo, solver.node_stress()(i, StressComponent::yy));
+        hi = std::max(hi, solver.node_stress()(i, StressComponent::yy));
       }
       b.uniformity = std::max(b.uniformity, (hi - lo) / kGammaH);
     }

@@ -8,10 +8,11 @@
 
 #include <fmt/format.h>
 
-#include "case/case_setup.hpp"
+#include "case/case_reader.hpp"
 #include "core/error.hpp"
-#include "solvers/staggered_solver.hpp"
+#include "schemes/simulation.hpp"
 #include "validation/analytic_saturated.hpp"
+#include "validation/saturated_common.hpp"
 #include "validation/validation.hpp"
 
 namespace rktsph::validation {
@@ -52,12 +53,12 @@ ColumnRun run_column(const std::string& case_file, double dx) {
                                         "output.times=[]"};
   const CaseDocument doc = load_case_document(case_file, set);
   CaseSetup<1> setup = read_case<1>(doc);
-  StaggeredSolver<1> solver(setup);
+  Simulation<1> solver(setup);
   const analytic::SaturatedColumn col = column13();
   const analytic::Terzaghi ref{col, kQ, kRamp};
   const double p0 = kQ * col.skempton();
   const double sinf = ref.final_settlement();
-  const auto& nodes = solver.particles().nodes;
+  const auto& nodes = solver.nodes();
   const auto nn = static_cast<std::size_t>(nodes.size());
   std::vector<std::size_t> order(nn);
   for (std::size_t i = 0; i < nn; ++i) order[i] = i;
@@ -90,7 +91,7 @@ ColumnRun run_column(const std::string& case_file, double dx) {
     mean_p /= kH;
     const double fraction = std::min(t / kRamp, 1.0);
     const double u_h = fraction > 0.0 ? 1.0 - mean_p / (p0 * fraction) : 0.0;
-    const double s_h = -solver.node_displacement()[top];
+    const double s_h = -solver.node_displacement()(top, 0);
     if (t >= 1.0) {  // the degree of consolidation is compared once the load is on
       out.u_err = std::max(out.u_err, std::abs(u_h - ref.degree(t)));
     }
@@ -131,13 +132,13 @@ ColumnRun run_column(const std::string& case_file, double dx) {
     }
   }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  out.s_final = -solver.node_displacement()[top];
-  const PressureSolveStats* ps = solver.pressure_stats();
+  out.s_final = -solver.node_displacement()(top, 0);
+  const PressureSolveStats* ps = &pressure_stage(solver, "case 13").stats();
   if (ps == nullptr) throw SolverError("the case file is not a V3 (saturated) case");
   out.iterations_max = ps->max_iterations;
   out.iterations_mean = ps->mean_iterations();
   out.residual = ps->max_error;
-  out.pressure_share = solver.pressure_step_seconds() / out.seconds;
+  out.pressure_share = pressure_stage(solver, "case 13").seconds() / out.seconds;
   return out;
 }
 

@@ -9,10 +9,11 @@
 
 #include <fmt/format.h>
 
-#include "case/case_setup.hpp"
+#include "case/case_reader.hpp"
 #include "core/error.hpp"
-#include "solvers/staggered_solver.hpp"
+#include "schemes/simulation.hpp"
 #include "validation/analytic_saturated.hpp"
+#include "validation/saturated_common.hpp"
 #include "validation/validation.hpp"
 
 namespace rktsph::validation {
@@ -60,9 +61,9 @@ HarmonicRun run_harmonic(const std::string& case_file, double period, double dx)
                                         fmt::format("functions.load.frequency={}", 1.0 / period)};
   const CaseDocument doc = load_case_document(case_file, set);
   CaseSetup<1> setup = read_case<1>(doc);
-  StaggeredSolver<1> solver(setup);
+  Simulation<1> solver(setup);
   const analytic::HarmonicColumn ref(column14(), 2.0 * std::numbers::pi / period, kQ0);
-  const auto& nodes = solver.particles().nodes;
+  const auto& nodes = solver.nodes();
   const auto nn = static_cast<std::size_t>(nodes.size());
   std::vector<std::size_t> order(nn);
   for (std::size_t i = 0; i < nn; ++i) order[i] = i;
@@ -87,7 +88,7 @@ HarmonicRun run_harmonic(const std::string& case_file, double period, double dx)
   for (long n = 1; n <= steps; ++n) {
     solver.step();
     const double t = solver.time();
-    const double u = -solver.node_displacement()[top];  // downward
+    const double u = -solver.node_displacement()(top, 0);  // downward
     if (t >= end - 2.0 * period) {
       for (std::size_t k = 0; k < nn; ++k) {
         out.envelope[k] = std::max(out.envelope[k], std::abs(solver.node_pore_pressure()[order[k]]) / kQ0);
@@ -107,11 +108,11 @@ HarmonicRun run_harmonic(const std::string& case_file, double period, double dx)
   out.peak = *std::max_element(out.envelope.begin(), out.envelope.end());
   out.u_amp = 0.5 * (umax - umin);
   out.u_ref = std::abs(ref.displacement(0.0));
-  const PressureSolveStats* ps = solver.pressure_stats();
+  const PressureSolveStats* ps = &pressure_stage(solver, "case 14").stats();
   if (ps == nullptr) throw SolverError("the case file is not a V3 (saturated) case");
   out.iterations_max = ps->max_iterations;
   out.iterations_mean = ps->mean_iterations();
-  out.pressure_share = solver.pressure_step_seconds() / out.seconds;
+  out.pressure_share = pressure_stage(solver, "case 14").seconds() / out.seconds;
   return out;
 }
 

@@ -18,9 +18,10 @@
 
 #include <fmt/format.h>
 
-#include "case/case_setup.hpp"
+#include "case/case_reader.hpp"
 #include "core/error.hpp"
-#include "solvers/staggered_solver.hpp"
+#include "schemes/simulation.hpp"
+#include "validation/saturated_common.hpp"
 #include "validation/validation.hpp"
 
 namespace rktsph::validation {
@@ -51,8 +52,8 @@ std::size_t nearest(const ParticleSet<2>& nodes, double x, double y) {
 }
 
 // max |p_I - mean of the 4 lattice neighbours| / sigma0 over nodes more than 3 dx from every face.
-double checkerboard(const StaggeredSolver<2>& s, double dx) {
-  const auto& nodes = s.particles().nodes;
+double checkerboard(const Simulation<2>& s, double dx) {
+  const auto& nodes = s.nodes();
   const auto& pw = s.node_pore_pressure();
   double worst = 0.0;
   for (std::size_t i = 0; i < static_cast<std::size_t>(nodes.size()); ++i) {
@@ -87,8 +88,8 @@ CaseReport validate_case15(const Options& opt, const std::string& dir) {
     const CaseDocument doc = load_case_document(
         case_file, {fmt::format("geometry.spacing={}", dx), "fluid.conductivity=1e-5", "time.end=1.5", "output.times=[]"});
     CaseSetup<2> setup = read_case<2>(doc);
-    StaggeredSolver<2> solver(setup);
-    const auto& nodes = solver.particles().nodes;
+    Simulation<2> solver(setup);
+    const auto& nodes = solver.nodes();
     std::vector<std::size_t> idx;
     for (const auto& p : kPoints) idx.push_back(nearest(nodes, p.x, kSurface - p.depth));
     const std::size_t centre = nearest(nodes, 0.0, kSurface);
@@ -102,13 +103,13 @@ CaseReport validate_case15(const Options& opt, const std::string& dir) {
     while (solver.time() < 1.5 - 1e-9) {
       solver.step();
       if (solver.step_count() % 10 == 0) {
-        hist << fmt::format("{:.5g},{:.6e}", solver.time(), -solver.node_displacement()[centre * 2 + 1]);
+        hist << fmt::format("{:.5g},{:.6e}", solver.time(), -solver.node_displacement()(centre, 1));
         for (std::size_t k = 0; k < kPoints.size(); ++k) hist << fmt::format(",{:.6g}", solver.node_pore_pressure()[idx[k]] / kSigma0);
         hist << "\n";
       }
       if (solver.time() >= 0.5) {
         for (std::size_t k = 0; k < kPoints.size(); ++k) sum[k] += solver.node_pore_pressure()[idx[k]];
-        settle += -solver.node_displacement()[centre * 2 + 1];
+        settle += -solver.node_displacement()(centre, 1);
         ++count;
       }
     }
@@ -132,8 +133,8 @@ CaseReport validate_case15(const Options& opt, const std::string& dir) {
   {
     const CaseDocument doc = load_case_document(case_file, {fmt::format("geometry.spacing={}", dx), "output.times=[]"});
     CaseSetup<2> setup = read_case<2>(doc);
-    StaggeredSolver<2> solver(setup);
-    const auto& nodes = solver.particles().nodes;
+    Simulation<2> solver(setup);
+    const auto& nodes = solver.nodes();
     const std::size_t centre = nearest(nodes, 0.0, kSurface), edge = nearest(nodes, 3.0, kSurface);
     std::ofstream hist(fmt::format("{}/consolidation_dx{}.csv", dir, dx));
     hist << "t,centre_settlement,edge_settlement,max_pw\n";
@@ -147,10 +148,10 @@ CaseReport validate_case15(const Options& opt, const std::string& dir) {
     while (solver.time() < 130.0 - 1e-9) {
       solver.step();
       if (solver.step_count() % every != 0) continue;
-      const double sc = -solver.node_displacement()[centre * 2 + 1];
+      const double sc = -solver.node_displacement()(centre, 1);
       double pmax = 0.0;
       for (double p : solver.node_pore_pressure()) pmax = std::max(pmax, std::abs(p));
-      hist << fmt::format("{:.5g},{:.6e},{:.6e},{:.6g}\n", solver.time(), sc, -solver.node_displacement()[edge * 2 + 1], pmax / kSigma0);
+      hist << fmt::format("{:.5g},{:.6e},{:.6e},{:.6g}\n", solver.time(), sc, -solver.node_displacement()(edge, 1), pmax / kSigma0);
       if (solver.time() > 2.0) drop = std::max(drop, last - sc);  // consolidation settlement must not decrease
       const auto w = static_cast<std::size_t>(std::min(130.0, std::floor(solver.time())));
       window_sum[w] += sc;
@@ -165,7 +166,7 @@ CaseReport validate_case15(const Options& opt, const std::string& dir) {
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     double pmax = 0.0;
     for (double p : solver.node_pore_pressure()) pmax = std::max(pmax, std::abs(p));
-    const double sc = -solver.node_displacement()[centre * 2 + 1], se = -solver.node_displacement()[edge * 2 + 1];
+    const double sc = -solver.node_displacement()(centre, 1), se = -solver.node_displacement()(edge, 1);
     rep.metrics.push_back(metric(fmt::format("drained, dx = {}: final centre settlement relative error (1.091e-3 m)", dx),
                                  std::abs(sc - kCentreDrained) / kCentreDrained, "<=", 0.05, ""));
     rep.metrics.push_back(metric(fmt::format("drained, dx = {}: final edge settlement relative error (6.96e-4 m)", dx),
@@ -195,12 +196,12 @@ CaseReport validate_case15(const Options& opt, const std::string& dir) {
                                  window_drop / sc, "", 0.0, ""));
     rep.metrics.push_back(metric(fmt::format("drained, dx = {}: checkerboard max|p_I - mean of 4 neighbours| / sigma0 at 15 s", dx),
                                  checker, "<=", 0.01, ""));
-    const PressureSolveStats* ps = solver.pressure_stats();
+    const PressureSolveStats* ps = &pressure_stage(solver, "case 15").stats();
     if (ps == nullptr) throw SolverError("case 15 is not a V3 case");
     rep.notes.push_back(fmt::format("drained, dx = {}: centre {:.4e} m, edge {:.4e} m at 130 s; {} nodes, PCG (Jacobi) "
                                     "iterations mean {:.1f}, max {}, pressure step {:.0f} % of {:.0f} s",
                                     dx, sc, se, nodes.size(), ps->mean_iterations(), ps->max_iterations,
-                                    100.0 * solver.pressure_step_seconds() / seconds, seconds));
+                                    100.0 * pressure_stage(solver, "case 15").seconds() / seconds, seconds));
   }
   if (!opt.full) rep.notes.push_back("quick mode: dx = 0.25 m; --full runs dx = 0.2 m (CASES.md)");
   return rep;

@@ -10,9 +10,9 @@
 
 #include <fmt/format.h>
 
-#include "case/case_setup.hpp"
+#include "case/case_reader.hpp"
 #include "core/error.hpp"
-#include "solvers/staggered_solver.hpp"
+#include "schemes/simulation.hpp"
 #include "validation/band_common.hpp"
 #include "validation/saturated_common.hpp"
 #include "validation/validation.hpp"
@@ -108,13 +108,12 @@ SatRun run_sample(const std::string& case_file, double dx, double k, double end_
   }
   const CaseDocument doc = load_case_document(case_file, set);
   CaseSetup<2> setup = read_case<2>(doc);
-  StaggeredSolver<2> solver(setup);
-  if (!solver.saturated()) throw SolverError("case 16: the case file is not a V3 (saturated) case");
-  constexpr int NV = StaggeredSolver<2>::NV;
-  const auto& nodes = solver.particles().nodes;
+  Simulation<2> solver(setup);
+  pressure_stage(solver, "case 16");  // throws for a dry case
+  const auto& nodes = solver.nodes();
   const auto nn = static_cast<std::size_t>(nodes.size());
-  const NodeHistory eps_of(solver, "eps_vp_eq", "case 16");
-  auto q_of = [&](std::size_t i) { return invariants(to_sym6<2>(&solver.node_phi()[i * NV + 2])).q; };
+  const HistoryView eps_of = node_history(solver, "eps_vp_eq", "case 16");
+  auto q_of = [&](std::size_t i) { return solver.node_stress().invariants(i).q; };
   double volume = 0.0;
   for (std::size_t i = 0; i < nn; ++i) volume += nodes.volume[i];
 
@@ -137,7 +136,7 @@ SatRun run_sample(const std::string& case_file, double dx, double k, double end_
     Sym6 avg{};
     double eps_mean = 0.0, eps_sq = 0.0, pw_mean = 0.0;
     for (std::size_t i = 0; i < nn; ++i) {
-      const Sym6 s = to_sym6<2>(&solver.node_phi()[i * NV + 2]);
+      const Sym6 s = solver.node_stress().sym6(i);
       const double w = nodes.volume[i] / volume;
       for (std::size_t c = 0; c < 6; ++c) avg[c] += w * s[c];
       const double e = eps_of(i);
@@ -190,8 +189,8 @@ SatRun run_sample(const std::string& case_file, double dx, double k, double end_
         s.eps.push_back(eps_of(i));
         s.pw.push_back(solver.node_pore_pressure()[i]);
         s.q.push_back(q_of(i));
-        s.vx.push_back(solver.node_phi()[i * NV]);
-        s.vy.push_back(solver.node_phi()[i * NV + 1]);
+        s.vx.push_back(solver.node_velocity()(i, 0));
+        s.vy.push_back(solver.node_velocity()(i, 1));
       }
       double rms = 0.0, scale = 0.0;
       const double c = checkerboard_amplitude(s.x, s.y, s.pw, dx, &rms);
@@ -265,12 +264,12 @@ SatRun run_sample(const std::string& case_file, double dx, double k, double end_
   }
   out.steps = solver.step_count();
   out.max_substeps = solver.max_source_substeps();
-  if (const PressureSolveStats* ps = solver.pressure_stats(); ps != nullptr) {  // V3: always set
+  if (const PressureSolveStats* ps = &pressure_stage(solver, "case 16").stats(); ps != nullptr) {  // V3: always set
     out.iterations_max = ps->max_iterations;
     out.iterations_mean = ps->mean_iterations();
     out.residual = ps->max_error;
   }
-  out.pressure_share = solver.pressure_step_seconds() / out.seconds;
+  out.pressure_share = pressure_stage(solver, "case 16").seconds() / out.seconds;
   return out;
 }
 

@@ -30,17 +30,16 @@ struct PwState {
   std::vector<double> pw, p_total;
 };
 
-PwState capture(const StaggeredSolver<2>& solver) {
-  constexpr int NV = StaggeredSolver<2>::NV;
+PwState capture(const Simulation<2>& solver) {
   PwState s;
   s.time = solver.time();
   s.cut = snapshot(solver, solver.time());
-  const auto n = static_cast<std::size_t>(solver.particles().nodes.size());
+  const auto n = static_cast<std::size_t>(solver.nodes().size());
   for (std::size_t i = 0; i < n; ++i) {
-    const double* phi = &solver.node_phi()[i * NV];
+    const Sym6 sig = solver.node_stress().sym6(i);
     const double pw = solver.node_pore_pressure()[i];
     s.pw.push_back(pw);
-    s.p_total.push_back(-(phi[2] + phi[3] + phi[4]) / 3.0 + pw);
+    s.p_total.push_back(-(sig[0] + sig[1] + sig[2]) / 3.0 + pw);
   }
   return s;
 }
@@ -73,7 +72,7 @@ SatCut run_saturated_cut(const std::string& file, double dx, double n_stab, doub
   const std::vector<std::string> set = {fmt::format("geometry.spacing={}", dx), "output.interval=0",
                                         fmt::format("material.cohesion={:.6g}", c),
                                         fmt::format("fluid.conductivity={:g}", k)};
-  r.run = run_cut(file, set, 0.01, 0.1, [&](const StaggeredSolver<2>& s) {
+  r.run = run_cut(file, set, 0.01, 0.1, [&](const Simulation<2>& s) {
     const double h = 0.5 * s.dt();
     if (std::isnan(r.ramp.time) && s.time() >= kRampEnd - h) r.ramp = capture(s);
     if (std::isnan(r.hold.time) && s.time() >= kHoldEnd - h) r.hold = capture(s);

@@ -9,7 +9,7 @@
 
 #include <fmt/format.h>
 
-#include "case/case_setup.hpp"
+#include "case/case_reader.hpp"
 #include "core/error.hpp"
 #include "validation/validation.hpp"
 
@@ -64,32 +64,26 @@ Classification classify_cut(const std::vector<double>& t, const std::vector<doub
   return c;
 }
 
-CutSnapshot snapshot(const StaggeredSolver<2>& solver, double time) {
-  constexpr int NV = StaggeredSolver<2>::NV;
-  const auto& nodes = solver.particles().nodes;
+CutSnapshot snapshot(const Simulation<2>& solver, double time) {
+  const auto& nodes = solver.nodes();
   const auto nn = static_cast<std::size_t>(nodes.size());
-  const auto& names = solver.history_names();
-  const auto it = std::find(names.begin(), names.end(), "eps_vp_eq");
-  const auto stride = static_cast<std::size_t>(solver.history_stride());
+  const bool has_eps = solver.history_layout().find("eps_vp_eq") >= 0;
+  const auto v = solver.node_velocity();
+  const auto u = solver.node_displacement();
+  const auto sig = solver.node_stress();
   CutSnapshot s;
   s.time = time;
   for (std::size_t i = 0; i < nn; ++i) {
-    const double* phi = &solver.node_phi()[i * NV];
     s.x.push_back(nodes.position[i][0]);
     s.y.push_back(nodes.position[i][1]);
-    s.ux.push_back(solver.node_displacement()[2 * i]);
-    s.uy.push_back(solver.node_displacement()[2 * i + 1]);
-    s.vx.push_back(phi[0]);
-    s.vy.push_back(phi[1]);
-    s.sxx.push_back(phi[2]);
-    s.syy.push_back(phi[3]);
-    s.sxy.push_back(phi[5]);
-    double e = 0.0;
-    if (it != names.end()) {
-      const int sl = solver.history_slot(nodes.material[i], static_cast<std::size_t>(it - names.begin()));
-      if (sl >= 0) e = solver.node_history()[i * stride + static_cast<std::size_t>(sl)];
-    }
-    s.eps.push_back(e);
+    s.ux.push_back(u(i, 0));
+    s.uy.push_back(u(i, 1));
+    s.vx.push_back(v(i, 0));
+    s.vy.push_back(v(i, 1));
+    s.sxx.push_back(sig(i, StressComponent::xx));
+    s.syy.push_back(sig(i, StressComponent::yy));
+    s.sxy.push_back(sig(i, StressComponent::xy));
+    s.eps.push_back(has_eps ? solver.node_history("eps_vp_eq")(i) : 0.0);
   }
   return s;
 }
@@ -106,9 +100,8 @@ CutRun run_cut(const std::string& file, const std::vector<std::string>& override
   const auto t0 = std::chrono::steady_clock::now();
   const CaseDocument doc = load_case_document(file, overrides);
   CaseSetup<2> setup = read_case<2>(doc);
-  StaggeredSolver<2> solver(setup);
-  constexpr int NV = StaggeredSolver<2>::NV;
-  const auto& nodes = solver.particles().nodes;
+  Simulation<2> solver(setup);
+  const auto& nodes = solver.nodes();
   const auto nn = static_cast<std::size_t>(nodes.size());
   CutRun r;
   r.dx = setup.dx;
@@ -125,12 +118,12 @@ CutRun run_cut(const std::string& file, const std::vector<std::string>& override
   auto record = [&]() {
     double ke = 0.0;
     for (std::size_t i = 0; i < nn; ++i) {
-      const double* phi = &solver.node_phi()[i * NV];
-      ke += 0.5 * nodes.mass(static_cast<Index>(i)) * (phi[0] * phi[0] + phi[1] * phi[1]);
+      const double vx = solver.node_velocity()(i, 0), vy = solver.node_velocity()(i, 1);
+      ke += 0.5 * nodes.mass(static_cast<Index>(i)) * (vx * vx + vy * vy);
     }
     r.t.push_back(solver.time());
-    r.uc.push_back(solver.node_displacement()[2 * crest]);
-    r.uyc.push_back(solver.node_displacement()[2 * crest + 1]);
+    r.uc.push_back(solver.node_displacement()(crest, 0));
+    r.uyc.push_back(solver.node_displacement()(crest, 1));
     r.ke.push_back(ke);
   };
   const long steps = static_cast<long>(std::ceil(setup.end_time / solver.dt() - 1e-9));
@@ -140,7 +133,7 @@ CutRun run_cut(const std::string& file, const std::vector<std::string>& override
     for (long n = 1; n <= steps; ++n) {
       solver.step();
       if (hook) hook(solver);
-      const double uc = solver.node_displacement()[2 * crest];
+      const double uc = solver.node_displacement()(crest, 0);
       if (onset_uc > 0.0 && !r.has_onset && uc > onset_uc) {
         r.onset = snapshot(solver, solver.time());
         r.has_onset = true;
@@ -157,7 +150,7 @@ CutRun run_cut(const std::string& file, const std::vector<std::string>& override
   r.final_state = snapshot(solver, solver.time());
   {
     // Traction residuals from the stress points next to the face and the top.
-    const auto& el = solver.particles().elements;
+    const auto& el = solver.stress_points();
     const auto ne = static_cast<std::size_t>(el.size());
     std::map<long, std::pair<double, double>> face1, face2, top1, top2;  // row -> (s_n, s_t)
     double xmax = 0.0, ymax = 0.0;
@@ -166,13 +159,15 @@ CutRun run_cut(const std::string& file, const std::vector<std::string>& override
       ymax = std::max(ymax, el.position[e][1]);
     }
     for (std::size_t e = 0; e < ne; ++e) {
-      const double* phi = &solver.element_phi()[e * NV];
+      const auto sig = solver.stress_point_stress();
+      const double sxx = sig(e, StressComponent::xx), syy = sig(e, StressComponent::yy);
+      const double sxy = sig(e, StressComponent::xy);
       const auto& p = el.position[e];
       const long row = std::lround(p[1] / r.dx * 2.0), col = std::lround(p[0] / r.dx * 2.0);
-      if (std::abs(p[0] - xmax) < 1e-6 * r.dx) face1[row] = {phi[2], phi[5]};
-      if (std::abs(p[0] - (xmax - r.dx)) < 1e-6 * r.dx) face2[row] = {phi[2], phi[5]};
-      if (std::abs(p[1] - ymax) < 1e-6 * r.dx) top1[col] = {phi[3], phi[5]};
-      if (std::abs(p[1] - (ymax - r.dx)) < 1e-6 * r.dx) top2[col] = {phi[3], phi[5]};
+      if (std::abs(p[0] - xmax) < 1e-6 * r.dx) face1[row] = {sxx, sxy};
+      if (std::abs(p[0] - (xmax - r.dx)) < 1e-6 * r.dx) face2[row] = {sxx, sxy};
+      if (std::abs(p[1] - ymax) < 1e-6 * r.dx) top1[col] = {syy, sxy};
+      if (std::abs(p[1] - (ymax - r.dx)) < 1e-6 * r.dx) top2[col] = {syy, sxy};
     }
     // Extrapolation to the boundary at distance (boundary - outer column) = W - xmax.
     const double fx = (r.width - xmax) / r.dx, fy = (r.height - ymax) / r.dx;
@@ -197,7 +192,7 @@ CutRun run_cut(const std::string& file, const std::vector<std::string>& override
                                  std::abs(a.second + fy * (a.second - b->second.second))});
     }
   }
-  r.damping_off_time = solver.damping_off_time();
+  r.damping_off_time = solver.clock().damping_off_time();
   r.peak_ke = *std::max_element(r.ke.begin(), r.ke.end());
   r.steps = solver.step_count();
   r.max_substeps = solver.max_source_substeps();

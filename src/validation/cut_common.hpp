@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "solvers/staggered_solver.hpp"
+#include "schemes/simulation.hpp"
 
 namespace rktsph::validation {
 
@@ -78,7 +78,7 @@ struct CutRun {
   Classification classification;
 };
 
-using StepHook = std::function<void(const StaggeredSolver<2>&)>;
+using StepHook = std::function<void(const Simulation<2>&)>;
 
 /// Run a 2D cut case file with --set overrides, recording the histories every `record_dt`
 /// seconds (and calling `hook` after every step if given). `onset_uc` (m) > 0 takes a snapshot
@@ -87,7 +87,7 @@ using StepHook = std::function<void(const StaggeredSolver<2>&)>;
 CutRun run_cut(const std::string& file, const std::vector<std::string>& overrides, double record_dt,
                double onset_uc = 0.0, const StepHook& hook = {});
 
-CutSnapshot snapshot(const StaggeredSolver<2>& solver, double time);
+CutSnapshot snapshot(const Simulation<2>& solver, double time);
 
 /// Value of a nodal field at the lattice node nearest to (x, y).
 double at_node(const CutSnapshot& s, const std::vector<double>& field, double x, double y);

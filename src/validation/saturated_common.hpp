@@ -1,9 +1,20 @@
 #pragma once
-// Shared by the saturated 2-D validation cases 16 and 17: measures of a nodal pore-pressure
-// field on the regular particle lattice.
+// Shared by the saturated validation cases 13-17: the pressure stage of a run, and measures of a
+// nodal pore-pressure field on the regular particle lattice.
 #include <vector>
 
+#include "schemes/pressure_stage.hpp"
+#include "schemes/simulation.hpp"
+
 namespace rktsph::validation {
+
+/// The pressure stage of a saturated run (throws SolverError naming `who` if the run is dry).
+template <int Dim>
+const PorePressureStage<Dim>& pressure_stage(const Simulation<Dim>& solver, const char* who) {
+  const auto* stage = solver.scheme().template find<PorePressureStage<Dim>>();
+  if (stage == nullptr) throw SolverError(std::string(who) + ": the case file is not a V3 (saturated) case");
+  return *stage;
+}
 
 /// Odd-even (checkerboard) content of a nodal field f on the regular lattice of spacing dx.
 /// At every node whose 5-point stencils along x and along y lie inside the body, the

@@ -51,7 +51,7 @@ TEST(SetOverride, CreatesMissingTablesAndBareWordsAreStrings) {
   // [solver] is absent from the bar case: --set creates it; 'false' is a TOML boolean.
   const auto c = read_case<1>(load_case_document(kBar, {"solver.filter=false", "solver.scheme=collocated"}));
   EXPECT_FALSE(c.filter);
-  EXPECT_EQ(c.scheme, Scheme::collocated);
+  EXPECT_EQ(c.layout, ParticleLayout::collocated);
 }
 
 TEST(SetOverride, TypeCheckedLikeTheFile) {

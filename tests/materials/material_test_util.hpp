@@ -6,6 +6,7 @@
 #include <toml++/toml.h>
 
 #include "io/section.hpp"
+#include "case/material_reader.hpp"
 #include "materials/material.hpp"
 
 namespace rktsph::test {
@@ -16,7 +17,7 @@ inline std::unique_ptr<Material> material_from_toml(const std::string& body,
   const toml::table root = toml::parse("[material]\n" + body, file);
   const io::Section top(root, "", std::make_shared<const std::string>(file));
   const io::Section mat = top.table("material");
-  auto m = create_material(mat);
+  auto m = read_material(mat);
   mat.finish();
   return m;
 }

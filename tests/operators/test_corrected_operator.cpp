@@ -12,7 +12,7 @@
 #include <fmt/format.h>
 
 #include "core/kernel.hpp"
-#include "geometry/particles.hpp"
+#include "particles/lattice.hpp"
 #include "operators/corrected_operator.hpp"
 
 namespace rktsph {
@@ -61,20 +61,20 @@ void jitter(std::vector<Vec<Dim>>& x, double amplitude, std::mt19937& rng) {
   }
 }
 
-Discretisation<1> bar(double length, double dx) {
+LatticeParticles<1> bar(double length, double dx) {
   Block<1> b;
   b.min = Vec<1>(0.0);
   b.max = Vec<1>(length);
   b.label = "bar";
-  return discretise<1>({b}, dx, Vec<1>(0.0), {1000.0});
+  return generate_lattice<1>({b}, dx, Vec<1>(0.0), {1000.0});
 }
 
-Discretisation<2> plate(double lx, double ly, double dx) {
+LatticeParticles<2> plate(double lx, double ly, double dx) {
   Block<2> b;
   b.min = Vec<2>(0.0, 0.0);
   b.max = Vec<2>(lx, ly);
   b.label = "plate";
-  return discretise<2>({b}, dx, Vec<2>(0.0, 0.0), {1000.0});
+  return generate_lattice<2>({b}, dx, Vec<2>(0.0, 0.0), {1000.0});
 }
 
 constexpr double kTol = 1e-12;
@@ -85,15 +85,15 @@ class Operator1D : public ::testing::TestWithParam<bool> {};  // parameter: jitt
 
 TEST_P(Operator1D, ExactForConstantAndLinearBothDirections) {
   const double dx = 0.25, L = 5.0;
-  Discretisation<1> disc = bar(L, dx);
+  LatticeParticles<1> disc = bar(L, dx);
   if (GetParam()) {
     std::mt19937 rng(12345);
     jitter(disc.nodes.position, 0.2 * dx, rng);
-    jitter(disc.elements.position, 0.2 * dx, rng);
+    jitter(disc.stress_points.position, 0.2 * dx, rng);
   }
   const CubicSplineKernel<1> kernel(1.2 * dx);
-  const auto en = build_corrected_operator<1>(disc.elements.position, disc.nodes, kernel);
-  const auto ne = build_corrected_operator<1>(disc.nodes.position, disc.elements, kernel);
+  const auto en = build_corrected_operator<1>(disc.stress_points.position, disc.nodes, kernel);
+  const auto ne = build_corrected_operator<1>(disc.nodes.position, disc.stress_points, kernel);
   EXPECT_EQ(en.degenerate_rows, 0);
   EXPECT_EQ(ne.degenerate_rows, 0);
   const double scale = 10.0;  // |f| over the bar
@@ -103,8 +103,8 @@ TEST_P(Operator1D, ExactForConstantAndLinearBothDirections) {
   auto glin = [](const Vec<1>&) { return Vec<1>(1.7); };
   for (const auto* op : {&en, &ne}) {
     const bool to_elements = op == &en;
-    const auto& targets = to_elements ? disc.elements.position : disc.nodes.position;
-    const auto& sources = to_elements ? disc.nodes : disc.elements;
+    const auto& targets = to_elements ? disc.stress_points.position : disc.nodes.position;
+    const auto& sources = to_elements ? disc.nodes : disc.stress_points;
     const auto ec = apply_errors<1>(*op, targets, sources, c, zero, scale);
     const auto el = apply_errors<1>(*op, targets, sources, lin, glin, scale);
     EXPECT_LT(ec.interp, kTol);
@@ -114,7 +114,7 @@ TEST_P(Operator1D, ExactForConstantAndLinearBothDirections) {
     RecordProperty(to_elements ? "linear_grad_err_en" : "linear_grad_err_ne", fmt::format("{:.3g}", el.grad));
   }
   // The end node x = 0 has only elements on one side (truncated support): check it alone.
-  const auto end = apply_errors<1>(ne, disc.nodes.position, disc.elements, lin, glin, scale,
+  const auto end = apply_errors<1>(ne, disc.nodes.position, disc.stress_points, lin, glin, scale,
                                    [&](const Vec<1>& x) { return x[0] < 0.5 * dx || x[0] > L - 0.5 * dx; });
   EXPECT_LT(end.interp, kTol);
   EXPECT_LT(end.grad, kTol);
@@ -128,15 +128,15 @@ class Operator2D : public ::testing::TestWithParam<bool> {};  // parameter: jitt
 
 TEST_P(Operator2D, ExactForConstantAndLinearBothDirections) {
   const double dx = 0.5, lx = 4.0, ly = 3.0;
-  Discretisation<2> disc = plate(lx, ly, dx);
+  LatticeParticles<2> disc = plate(lx, ly, dx);
   if (GetParam()) {
     std::mt19937 rng(2024);
     jitter(disc.nodes.position, 0.2 * dx, rng);
-    jitter(disc.elements.position, 0.2 * dx, rng);
+    jitter(disc.stress_points.position, 0.2 * dx, rng);
   }
   const CubicSplineKernel<2> kernel(1.2 * dx);
-  const auto en = build_corrected_operator<2>(disc.elements.position, disc.nodes, kernel);
-  const auto ne = build_corrected_operator<2>(disc.nodes.position, disc.elements, kernel);
+  const auto en = build_corrected_operator<2>(disc.stress_points.position, disc.nodes, kernel);
+  const auto ne = build_corrected_operator<2>(disc.nodes.position, disc.stress_points, kernel);
   EXPECT_EQ(en.degenerate_rows, 0);
   EXPECT_EQ(ne.degenerate_rows, 0);
   const double scale = 10.0;
@@ -147,8 +147,8 @@ TEST_P(Operator2D, ExactForConstantAndLinearBothDirections) {
   double worst = 0.0;
   for (const auto* op : {&en, &ne}) {
     const bool to_elements = op == &en;
-    const auto& targets = to_elements ? disc.elements.position : disc.nodes.position;
-    const auto& sources = to_elements ? disc.nodes : disc.elements;
+    const auto& targets = to_elements ? disc.stress_points.position : disc.nodes.position;
+    const auto& sources = to_elements ? disc.nodes : disc.stress_points;
     const auto ec = apply_errors<2>(*op, targets, sources, c, zero, scale);
     const auto el = apply_errors<2>(*op, targets, sources, lin, glin, scale);
     EXPECT_LT(ec.interp, kTol);
@@ -168,8 +168,8 @@ TEST_P(Operator2D, ExactForConstantAndLinearBothDirections) {
   auto on_edge = [&](const Vec<2>& x) {
     return x[0] < tol_corner || x[0] > lx - tol_corner || x[1] < tol_corner || x[1] > ly - tol_corner;
   };
-  const auto corner = apply_errors<2>(ne, disc.nodes.position, disc.elements, lin, glin, scale, on_corner);
-  const auto edge = apply_errors<2>(ne, disc.nodes.position, disc.elements, lin, glin, scale, on_edge);
+  const auto corner = apply_errors<2>(ne, disc.nodes.position, disc.stress_points, lin, glin, scale, on_corner);
+  const auto edge = apply_errors<2>(ne, disc.nodes.position, disc.stress_points, lin, glin, scale, on_edge);
   EXPECT_LT(corner.interp, kTol);
   EXPECT_LT(corner.grad, kTol);
   EXPECT_LT(edge.interp, kTol);
@@ -187,14 +187,14 @@ TEST(CorrectedOperator, ExactAtArbitraryPointsNearCornersOfAnLShape) {
   a.max = Vec<2>(4, 2);
   b.min = Vec<2>(0, 2);
   b.max = Vec<2>(2, 4);
-  const auto disc = discretise<2>({a, b}, dx, Vec<2>(0, 0), {1800.0});
+  const auto disc = generate_lattice<2>({a, b}, dx, Vec<2>(0, 0), {1800.0});
   const CubicSplineKernel<2> kernel(1.2 * dx);
   const std::vector<Vec<2>> pts = {Vec<2>(0, 0),     Vec<2>(4, 0),   Vec<2>(4, 2),
                                    Vec<2>(2, 4),     Vec<2>(0, 4),   Vec<2>(2, 2),
                                    Vec<2>(2.1, 2.1), Vec<2>(0.13, 3.9), Vec<2>(3.3, 0.07)};
   const Field<2> lin = [](const Vec<2>& x) { return 4.0 + 0.5 * x[0] - 1.25 * x[1]; };
   auto glin = [](const Vec<2>&) { return Vec<2>(0.5, -1.25); };
-  for (const auto* set : {&disc.nodes, &disc.elements}) {
+  for (const auto* set : {&disc.nodes, &disc.stress_points}) {
     const auto op = build_corrected_operator<2>(pts, *set, kernel);
     EXPECT_EQ(op.degenerate_rows, 0);
     const auto e = apply_errors<2>(op, pts, *set, lin, glin, 10.0);
@@ -208,7 +208,7 @@ TEST(CorrectedOperator, QuadraticIsNotReproducedButErrorIsSmall) {
   // symmetric regular lattice) gives a nonzero, O(dx^2) interpolation error (regular
   // lattice) and a nonzero gradient error (jittered lattice) in the interior.
   const double dx = 0.25, lx = 4.0, ly = 4.0;
-  Discretisation<2> disc = plate(lx, ly, dx);
+  LatticeParticles<2> disc = plate(lx, ly, dx);
   const CubicSplineKernel<2> kernel(1.2 * dx);
   const Field<2> quad = [](const Vec<2>& x) { return x[0] * x[0] + 0.5 * x[0] * x[1] + x[1] * x[1]; };
   auto gquad = [](const Vec<2>& x) { return Vec<2>(2 * x[0] + 0.5 * x[1], 0.5 * x[0] + 2 * x[1]); };
@@ -217,17 +217,17 @@ TEST(CorrectedOperator, QuadraticIsNotReproducedButErrorIsSmall) {
   };
   const double scale = 16.0;
   {
-    const auto en = build_corrected_operator<2>(disc.elements.position, disc.nodes, kernel);
-    const auto e = apply_errors<2>(en, disc.elements.position, disc.nodes, quad, gquad, scale, interior);
+    const auto en = build_corrected_operator<2>(disc.stress_points.position, disc.nodes, kernel);
+    const auto e = apply_errors<2>(en, disc.stress_points.position, disc.nodes, quad, gquad, scale, interior);
     EXPECT_GT(e.interp, 1e-4);  // ~ second moment of the kernel, (h^2) / |f|
     EXPECT_LT(e.interp, 1e-1);
     RecordProperty("quadratic_interp_err_regular", fmt::format("{:.3g}", e.interp));
   }
   std::mt19937 rng(7);
   jitter(disc.nodes.position, 0.2 * dx, rng);
-  jitter(disc.elements.position, 0.2 * dx, rng);
-  const auto ne = build_corrected_operator<2>(disc.nodes.position, disc.elements, kernel);
-  const auto e = apply_errors<2>(ne, disc.nodes.position, disc.elements, quad, gquad, scale, interior);
+  jitter(disc.stress_points.position, 0.2 * dx, rng);
+  const auto ne = build_corrected_operator<2>(disc.nodes.position, disc.stress_points, kernel);
+  const auto e = apply_errors<2>(ne, disc.nodes.position, disc.stress_points, quad, gquad, scale, interior);
   EXPECT_GT(e.grad, 1e-6);
   EXPECT_LT(e.grad, 0.1);
   EXPECT_GT(e.interp, 1e-5);
@@ -239,10 +239,10 @@ TEST(CorrectedOperator, QuadraticIsNotReproducedButErrorIsSmall) {
 TEST(DifferenceGradient, ExactForLinearFieldWithExactFhat) {
   const double dx = 0.5, lx = 3.0, ly = 2.0;
   for (bool jittered : {false, true}) {
-    Discretisation<2> disc = plate(lx, ly, dx);
+    LatticeParticles<2> disc = plate(lx, ly, dx);
     if (jittered) {
       std::mt19937 rng(99);
-      jitter(disc.elements.position, 0.2 * dx, rng);
+      jitter(disc.stress_points.position, 0.2 * dx, rng);
     }
     const CubicSplineKernel<2> kernel(1.2 * dx);
     // Rows at every boundary node and a few interior ones.
@@ -250,7 +250,7 @@ TEST(DifferenceGradient, ExactForLinearFieldWithExactFhat) {
     for (Index i = 0; i < disc.nodes.size(); ++i) {
       if (disc.boundary.faces[static_cast<std::size_t>(i)] != 0 || i % 5 == 0) which.push_back(i);
     }
-    const auto g = build_difference_gradient<2>(disc.nodes.position, which, disc.elements, kernel);
+    const auto g = build_difference_gradient<2>(disc.nodes.position, which, disc.stress_points, kernel);
     ASSERT_EQ(g.row_start.size(), which.size() + 1);
     ASSERT_EQ(g.weight_sum.size(), which.size());
     const Field<2> lin = [](const Vec<2>& x) { return 0.7 + 3.0 * x[0] - 1.1 * x[1]; };
@@ -261,7 +261,7 @@ TEST(DifferenceGradient, ExactForLinearFieldWithExactFhat) {
       Vec<2> sum = Vec<2>::Zero(), s = Vec<2>::Zero();
       for (Index k = g.row_start[r]; k < g.row_start[r + 1]; ++k) {
         const auto ku = static_cast<std::size_t>(k);
-        sum += g.weight[ku] * lin(disc.elements.position[static_cast<std::size_t>(g.source[ku])]);
+        sum += g.weight[ku] * lin(disc.stress_points.position[static_cast<std::size_t>(g.source[ku])]);
         s += g.weight[ku];
       }
       EXPECT_NEAR((s - g.weight_sum[r]).norm(), 0.0, 1e-12);

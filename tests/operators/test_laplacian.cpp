@@ -11,7 +11,7 @@
 #include <random>
 
 #include "core/kernel.hpp"
-#include "geometry/particles.hpp"
+#include "particles/lattice.hpp"
 #include "operators/corrected_operator.hpp"
 #include "operators/laplacian.hpp"
 

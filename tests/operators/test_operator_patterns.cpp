@@ -15,29 +15,29 @@
 
 #include "../support/test_util.hpp"
 #include "core/kernel.hpp"
-#include "geometry/particles.hpp"
+#include "particles/lattice.hpp"
 #include "operators/corrected_operator.hpp"
 
 namespace rktsph {
 namespace {
 
 template <int Dim>
-Discretisation<Dim> box(const Vec<Dim>& hi, double dx) {
+LatticeParticles<Dim> box(const Vec<Dim>& hi, double dx) {
   Block<Dim> b;
   b.min = Vec<Dim>::Zero();
   b.max = hi;
   b.label = "box";
-  return discretise<Dim>({b}, dx, Vec<Dim>::Zero(), {1000.0});
+  return generate_lattice<Dim>({b}, dx, Vec<Dim>::Zero(), {1000.0});
 }
 
 // L-shape: a convex corner at every end and a re-entrant corner at (2, 2).
-Discretisation<2> l_shape(double dx) {
+LatticeParticles<2> l_shape(double dx) {
   Block<2> a, b;
   a.min = Vec<2>(0, 0);
   a.max = Vec<2>(4, 2);
   b.min = Vec<2>(0, 2);
   b.max = Vec<2>(2, 4);
-  return discretise<2>({a, b}, dx, Vec<2>(0, 0), {1800.0});
+  return generate_lattice<2>({a, b}, dx, Vec<2>(0, 0), {1800.0});
 }
 
 template <int Dim>
@@ -112,14 +112,14 @@ struct Operators {
 };
 
 template <int Dim>
-Operators<Dim> build_all(const Discretisation<Dim>& disc, const CubicSplineKernel<Dim>& kernel) {
+Operators<Dim> build_all(const LatticeParticles<Dim>& disc, const CubicSplineKernel<Dim>& kernel) {
   Operators<Dim> ops;
   const OperatorOptions plain{.share_patterns = false};
-  ops.shared.push_back(build_corrected_operator<Dim>(disc.elements.position, disc.nodes, kernel));
-  ops.shared.push_back(build_corrected_operator<Dim>(disc.nodes.position, disc.elements, kernel));
+  ops.shared.push_back(build_corrected_operator<Dim>(disc.stress_points.position, disc.nodes, kernel));
+  ops.shared.push_back(build_corrected_operator<Dim>(disc.nodes.position, disc.stress_points, kernel));
   ops.shared.push_back(build_corrected_operator<Dim>(disc.nodes.position, disc.nodes, kernel));
-  ops.plain.push_back(build_corrected_operator<Dim>(disc.elements.position, disc.nodes, kernel, plain));
-  ops.plain.push_back(build_corrected_operator<Dim>(disc.nodes.position, disc.elements, kernel, plain));
+  ops.plain.push_back(build_corrected_operator<Dim>(disc.stress_points.position, disc.nodes, kernel, plain));
+  ops.plain.push_back(build_corrected_operator<Dim>(disc.nodes.position, disc.stress_points, kernel, plain));
   ops.plain.push_back(build_corrected_operator<Dim>(disc.nodes.position, disc.nodes, kernel, plain));
   return ops;
 }
@@ -162,10 +162,10 @@ TEST(OperatorPatterns, InteriorRowsShareOnePattern) {
   const double dx = 0.5;
   const auto disc = box<2>(Vec<2>(10.0, 10.0), dx);
   const CubicSplineKernel<2> kernel(1.2 * dx);
-  const auto en = build_corrected_operator<2>(disc.elements.position, disc.nodes, kernel);
+  const auto en = build_corrected_operator<2>(disc.stress_points.position, disc.nodes, kernel);
   Index interior = -1;
   for (Index e = 0; e < en.rows(); ++e) {
-    const Vec<2>& x = disc.elements.position[static_cast<std::size_t>(e)];
+    const Vec<2>& x = disc.stress_points.position[static_cast<std::size_t>(e)];
     if (x.minCoeff() < 3 * dx || x.maxCoeff() > 10.0 - 3 * dx) continue;
     if (interior < 0) interior = en.pattern[static_cast<std::size_t>(e)];
     EXPECT_EQ(en.pattern[static_cast<std::size_t>(e)], interior);
@@ -178,9 +178,9 @@ TEST(OperatorPatterns, InteriorRowsShareOnePattern) {
 TEST(OperatorPatterns, JitteredLatticeAgreesAndKeepsOnePatternPerRow) {
   std::mt19937 rng(77);
   const double dx = 0.25;
-  Discretisation<2> disc = box<2>(Vec<2>(4.0, 3.0), dx);
+  LatticeParticles<2> disc = box<2>(Vec<2>(4.0, 3.0), dx);
   jitter(disc.nodes.position, 0.2 * dx, rng);
-  jitter(disc.elements.position, 0.2 * dx, rng);
+  jitter(disc.stress_points.position, 0.2 * dx, rng);
   const CubicSplineKernel<2> kernel(1.2 * dx);
   const auto ops = build_all<2>(disc, kernel);
   for (std::size_t i = 0; i < ops.shared.size(); ++i) {
@@ -242,11 +242,11 @@ TEST(OperatorPatterns, IndependentOfTheThreadCount) {
   b.min = Vec<2>(1000.0, 0.0);
   b.max = Vec<2>(1008.0, 4.0);
   b.label = "strip";
-  const auto disc = discretise<2>({b}, dx, Vec<2>(1000.0, 0.0), {1000.0});
+  const auto disc = generate_lattice<2>({b}, dx, Vec<2>(1000.0, 0.0), {1000.0});
   const CubicSplineKernel<2> kernel(1.2 * dx);
   auto build = [&](int threads) {
     const test::ThreadCount guard(threads);
-    return build_corrected_operator<2>(disc.nodes.position, disc.elements, kernel);
+    return build_corrected_operator<2>(disc.nodes.position, disc.stress_points, kernel);
   };
   const auto one = build(1);
   const auto two = build(2);

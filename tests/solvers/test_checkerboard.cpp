@@ -9,7 +9,7 @@
 #include <fmt/format.h>
 
 #include "../support/test_util.hpp"
-#include "solvers/staggered_solver.hpp"
+#include "schemes/simulation.hpp"
 
 namespace rktsph {
 namespace {
@@ -40,14 +40,20 @@ filter = {}
 
 // Projection of the nodal velocity onto the checkerboard (-1)^(i+j), per component, over all
 // nodes: the amplitude of the mode that was seeded.
-double checkerboard_amplitude(const StaggeredSolver<2>& s) {
-  constexpr int NV = StaggeredSolver<2>::NV;
-  const auto& idx = s.particles().node_lattice_index;
+// The sign (-1)^(i+j) of the node at lattice coordinates (i, j).
+double parity(const Simulation<2>& s, std::size_t node) {
+  const auto& x = s.nodes().position[node];
+  const long i = std::lround(x[0] / s.setup().dx), j = std::lround(x[1] / s.setup().dx);
+  return (i + j) % 2 == 0 ? 1.0 : -1.0;
+}
+
+double checkerboard_amplitude(const Simulation<2>& s) {
   double num = 0.0, den = 0.0;
-  for (std::size_t i = 0; i < idx.size(); ++i) {
-    const double sign = (idx[i][0] + idx[i][1]) % 2 == 0 ? 1.0 : -1.0;
+  const auto v = s.node_velocity();
+  for (std::size_t i = 0; i < s.nodes().position.size(); ++i) {
+    const double sign = parity(s, i);
     for (int d = 0; d < 2; ++d) {
-      num += sign * s.node_phi()[i * NV + static_cast<std::size_t>(d)];
+      num += sign * v(i, d);
       den += 1.0;
     }
   }
@@ -58,22 +64,20 @@ double run_checkerboard(bool filter, int steps) {
   const test::ThreadCount threads(1);
   test::TempDir dir;
   auto setup = test::case_from_string<2>(dir, free_block(filter));
-  StaggeredSolver<2> solver(setup);
-  constexpr int NV = StaggeredSolver<2>::NV;
-  auto& phi = solver.mutable_node_phi();
-  const auto& idx = solver.particles().node_lattice_index;
-  for (std::size_t i = 0; i < idx.size(); ++i) {
-    const double sign = (idx[i][0] + idx[i][1]) % 2 == 0 ? 1.0 : -1.0;
-    phi[i * NV + 0] = kAmplitude * sign;
-    phi[i * NV + 1] = kAmplitude * sign;
+  Simulation<2> solver(setup);
+  auto v = solver.mutable_node_velocity();
+  for (std::size_t i = 0; i < solver.nodes().position.size(); ++i) {
+    const double sign = parity(solver, i);
+    v(i, 0) = kAmplitude * sign;
+    v(i, 1) = kAmplitude * sign;
   }
   const double a0 = checkerboard_amplitude(solver);
   EXPECT_NEAR(a0, kAmplitude, 1e-15);
   // Sanity: the elements cannot see the mode (their interpolated velocity is ~0 after step 1).
   solver.step();
   double emax = 0.0;
-  for (std::size_t e = 0; e < solver.element_phi().size() / NV; ++e) {
-    emax = std::max(emax, std::abs(solver.element_phi()[e * NV]));
+  for (Index e = 0; e < solver.stress_points().size(); ++e) {
+    emax = std::max(emax, std::abs(solver.stress_point_velocity()(e, 0)));
   }
   if (!filter) {
     EXPECT_LT(emax, 0.5 * kAmplitude);

@@ -7,7 +7,8 @@
 #include <cmath>
 
 #include "../support/test_util.hpp"
-#include "solvers/staggered_solver.hpp"
+#include "case/case_reader.hpp"
+#include "schemes/simulation.hpp"
 
 namespace rktsph {
 namespace {
@@ -18,8 +19,8 @@ TEST(Energy, BarUnderSmoothLoadBalancesWithinOnePercent) {
   auto setup = read_case<1>(load_case_document(
       file, {"functions.load.type=smoothstep", "functions.load.duration=0.0353553"}));
   const double L = 10.0, E = 1.0e7, sigma0 = 1.0e4;
-  StaggeredSolver<1> solver(setup);
-  ASSERT_EQ(solver.particles().nodes.size(), 101);
+  Simulation<1> solver(setup);
+  ASSERT_EQ(solver.nodes().size(), 101);
   const double c = std::sqrt(E / 2000.0);
   const double scale = sigma0 * 2.0 * sigma0 * L / E;  // 200 J: twice the work of sigma0 over L
   double worst = 0.0, max_work = 0.0;
@@ -65,7 +66,7 @@ velocity = { x = 0.0, y = 0.0 }
 end = 1.0
 cfl = 0.9
 )");
-  StaggeredSolver<2> solver(setup);
+  Simulation<2> solver(setup);
   double worst = 0.0, max_work = 0.0;
   while (solver.time() < 0.5) {
     solver.step();

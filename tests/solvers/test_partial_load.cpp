@@ -8,7 +8,7 @@
 #include <string>
 
 #include "../support/test_util.hpp"
-#include "solvers/staggered_solver.hpp"
+#include "schemes/simulation.hpp"
 
 namespace rktsph {
 namespace {
@@ -55,8 +55,8 @@ y = [5.0, 5.0]
 stress = { yy = -1.0e4, xy = 0.0 }
 )";
 
-std::size_t node_at(const StaggeredSolver<2>& s, double x, double y) {
-  const auto& p = s.particles().nodes.position;
+std::size_t node_at(const Simulation<2>& s, double x, double y) {
+  const auto& p = s.nodes().position;
   for (std::size_t i = 0; i < p.size(); ++i) {
     if (std::abs(p[i][0] - x) < 1e-9 && std::abs(p[i][1] - y) < 1e-9) return i;
   }
@@ -64,20 +64,17 @@ std::size_t node_at(const StaggeredSolver<2>& s, double x, double y) {
   return 0;
 }
 
-constexpr int NV = StaggeredSolver<2>::NV;
-constexpr int kSyy = 2 + 1;  // v_x, v_y, sigma_xx, sigma_yy, ...
-
 TEST(PartialLoad, NodeWhereTheLoadEndsTakesTheAverageTraction) {
   const test::ThreadCount threads(1);
   test::TempDir dir;
   auto setup = test::case_from_string<2>(dir, footing_case(kFooting));
-  StaggeredSolver<2> solver(setup);
+  Simulation<2> solver(setup);
   solver.step();
-  const auto& phi = solver.node_phi();
-  EXPECT_DOUBLE_EQ(phi[node_at(solver, 2.0, 5.0) * NV + kSyy], -1.0e4);
-  EXPECT_DOUBLE_EQ(phi[node_at(solver, 2.5, 5.0) * NV + kSyy], -0.5e4);  // half its segment loaded
-  EXPECT_DOUBLE_EQ(phi[node_at(solver, 3.0, 5.0) * NV + kSyy], 0.0);
-  EXPECT_DOUBLE_EQ(phi[node_at(solver, 0.0, 5.0) * NV + kSyy], -1.0e4);  // corner: its whole segment
+  const auto stress = solver.node_stress();
+  EXPECT_DOUBLE_EQ(stress(node_at(solver, 2.0, 5.0), StressComponent::yy), -1.0e4);
+  EXPECT_DOUBLE_EQ(stress(node_at(solver, 2.5, 5.0), StressComponent::yy), -0.5e4);  // half its segment loaded
+  EXPECT_DOUBLE_EQ(stress(node_at(solver, 3.0, 5.0), StressComponent::yy), 0.0);
+  EXPECT_DOUBLE_EQ(stress(node_at(solver, 0.0, 5.0), StressComponent::yy), -1.0e4);  // corner: its whole segment
 }
 
 TEST(PartialLoad, TwoLoadsMeetingAtANodeAdd) {
@@ -90,11 +87,11 @@ x = [2.5, 5.0]
 y = [5.0, 5.0]
 stress = { yy = -2.0e4 }
 )"));
-  StaggeredSolver<2> solver(setup);
+  Simulation<2> solver(setup);
   solver.step();
-  const auto& phi = solver.node_phi();
-  EXPECT_DOUBLE_EQ(phi[node_at(solver, 2.5, 5.0) * NV + kSyy], -1.5e4);
-  EXPECT_DOUBLE_EQ(phi[node_at(solver, 3.0, 5.0) * NV + kSyy], -2.0e4);
+  const auto stress = solver.node_stress();
+  EXPECT_DOUBLE_EQ(stress(node_at(solver, 2.5, 5.0), StressComponent::yy), -1.5e4);
+  EXPECT_DOUBLE_EQ(stress(node_at(solver, 3.0, 5.0), StressComponent::yy), -2.0e4);
 }
 
 // Damped footing: at rest, the displacements must stop moving (the nodal-velocity integration
@@ -103,16 +100,16 @@ TEST(PartialLoad, DampedFootingComesToRestWithoutDrift) {
   const test::ThreadCount threads(1);
   test::TempDir dir;
   auto setup = test::case_from_string<2>(dir, footing_case(kFooting));
-  StaggeredSolver<2> solver(setup);
+  Simulation<2> solver(setup);
   while (solver.time() < 3.0) solver.step();
   const auto edge = node_at(solver, 2.5, 5.0);
   const auto centre = node_at(solver, 0.0, 5.0);
-  const double u_edge = solver.node_displacement()[edge * 2 + 1];
-  const double u_centre = solver.node_displacement()[centre * 2 + 1];
+  const double u_edge = solver.node_displacement()(edge, 1);
+  const double u_centre = solver.node_displacement()(centre, 1);
   const double t0 = solver.time();
   while (solver.time() < t0 + 2.0) solver.step();
-  const double drift_edge = solver.node_displacement()[edge * 2 + 1] - u_edge;
-  const double drift_centre = solver.node_displacement()[centre * 2 + 1] - u_centre;
+  const double drift_edge = solver.node_displacement()(edge, 1) - u_edge;
+  const double drift_centre = solver.node_displacement()(centre, 1) - u_centre;
   EXPECT_LT(u_centre, -1e-4);
   // Integrating the nodal velocity, the edge node drifted by about 4 |u_centre| per second.
   // What is left is the slow approach to the steady state (the centre still settles by about
@@ -120,13 +117,13 @@ TEST(PartialLoad, DampedFootingComesToRestWithoutDrift) {
   EXPECT_LT(std::abs(drift_edge), 1e-5 * std::abs(u_centre)) << "edge settlement still moving";
   EXPECT_LT(std::abs(drift_centre), 3e-3 * std::abs(u_centre));
   // Vertical equilibrium: the base reactions sum to the load, sigma0 x 2.5 m.
-  const auto& disc = solver.particles();
+  const auto& disc = solver.model();
   double reaction = 0.0;
   for (std::size_t i = 0; i < disc.nodes.position.size(); ++i) {
     if (std::abs(disc.nodes.position[i][1]) > 1e-9) continue;
     const double x = disc.nodes.position[i][0];
     const double length = (x < 1e-9 || x > 5.0 - 1e-9) ? 0.25 : 0.5;
-    reaction += solver.node_phi()[i * NV + kSyy] * length;
+    reaction += solver.node_stress()(i, StressComponent::yy) * length;
   }
   EXPECT_NEAR(reaction / (-1.0e4 * 2.5), 1.0, 0.01);
 }

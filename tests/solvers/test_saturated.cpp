@@ -19,8 +19,8 @@
 #include "core/error.hpp"
 #include "core/kernel.hpp"
 #include "operators/laplacian.hpp"
-#include "solvers/pore_pressure.hpp"
-#include "solvers/staggered_solver.hpp"
+#include "linear_solvers/pore_pressure.hpp"
+#include "schemes/simulation.hpp"
 #include "validation/analytic_saturated.hpp"
 
 namespace rktsph {
@@ -163,11 +163,11 @@ UndrainedColumn run_undrained_column(const std::vector<std::string>& overrides) 
   test::TempDir dir;
   auto setup = test::case_from_string<1>(
       dir, column(10.0, 0.1, 0.0, "type = \"ramp\"\nduration = 2.0", 3.0, "impermeable = true"), overrides);
-  StaggeredSolver<1> solver(setup);
+  Simulation<1> solver(setup);
   UndrainedColumn out;
   out.dt = solver.dt();
   out.wave_speed = solver.max_wave_speed();
-  const auto& nodes = solver.particles().nodes;
+  const auto& nodes = solver.nodes();
   std::size_t mid = 0, top = 0;
   for (std::size_t i = 0; i < static_cast<std::size_t>(nodes.size()); ++i) {
     if (std::abs(nodes.position[i][0] - 5.0) < 1e-9) mid = i;
@@ -178,14 +178,14 @@ UndrainedColumn run_undrained_column(const std::vector<std::string>& overrides) 
     solver.step();
     if (solver.time() >= 2.0) {
       out.p_mid += solver.node_pore_pressure()[mid];
-      out.settlement += -solver.node_displacement()[top];
+      out.settlement += -solver.node_displacement()(top, 0);
       ++count;
     }
   }
   out.p_mid /= static_cast<double>(count);
   out.settlement /= static_cast<double>(count);
   out.p_top = solver.node_pore_pressure()[top];
-  out.sigma_mid = solver.node_phi()[mid * StaggeredSolver<1>::NV + 1];
+  out.sigma_mid = solver.node_stress()(mid, StressComponent::xx);
   return out;
 }
 
@@ -225,7 +225,7 @@ TEST(Saturated, IncrementalProjectionWithStressPointDivergenceIsUnstable) {
       {"solver.pressure_divergence=stress_points"});
   ASSERT_FALSE(setup.fluid.incremental);  // the reader's default with that divergence
   setup.fluid.incremental = true;
-  StaggeredSolver<1> solver(setup);
+  Simulation<1> solver(setup);
   double stopped_at = -1.0;
   try {
     while (solver.time() < 3.0 - 1e-9) solver.step();
@@ -244,12 +244,11 @@ TEST(Saturated, DrainedLimitReducesToV1) {
   const double end = 0.05;
   auto run = [&](const std::string& text, bool v3) {
     auto setup = test::case_from_string<1>(dir, text, {}, v3 ? "v3.toml" : "v1.toml");
-    StaggeredSolver<1> solver(setup);
+    Simulation<1> solver(setup);
     while (solver.time() < end - 1e-12) solver.step();
     std::vector<double> out;
-    constexpr int NV = StaggeredSolver<1>::NV;
-    for (std::size_t i = 0; i < static_cast<std::size_t>(solver.particles().nodes.size()); ++i) {
-      out.push_back(solver.node_phi()[i * NV + 1]);  // sigma'_xx (V3) or sigma_xx (V1)
+    for (std::size_t i = 0; i < static_cast<std::size_t>(solver.nodes().size()); ++i) {
+      out.push_back(solver.node_stress()(i, StressComponent::xx));  // sigma'_xx (V3) or sigma_xx (V1)
     }
     return out;
   };
@@ -324,7 +323,7 @@ end = 3.0
 cfl = 0.5
 )";
   auto setup = test::case_from_string<2>(dir, text);
-  StaggeredSolver<2> solver(setup);
+  Simulation<2> solver(setup);
   while (solver.time() < 3.0 - 1e-9) solver.step();
   analytic::SaturatedColumn col;
   col.height = 4.0;
@@ -335,7 +334,7 @@ cfl = 0.5
   const analytic::Terzaghi ref{col, 5.0e3, 0.5};
   const double p0 = 5.0e3 * col.skempton();
   double worst = 0.0;
-  const auto& nodes = solver.particles().nodes;
+  const auto& nodes = solver.nodes();
   for (std::size_t i = 0; i < static_cast<std::size_t>(nodes.size()); ++i) {
     const double depth = 4.0 - nodes.position[i][1];
     worst = std::max(worst, std::abs(solver.node_pore_pressure()[i] - ref.pressure(depth, solver.time())) / p0);
@@ -409,8 +408,8 @@ cfl = 0.5
 )",
                                        fmt::arg("mixture", undrained_mixture(incremental, filter)));
   auto setup = test::case_from_string<2>(dir, text);
-  StaggeredSolver<2> solver(setup);
-  const auto& nodes = solver.particles().nodes;
+  Simulation<2> solver(setup);
+  const auto& nodes = solver.nodes();
   std::size_t base = 0;
   for (std::size_t i = 0; i < static_cast<std::size_t>(nodes.size()); ++i) {
     if (std::abs(nodes.position[i][0] - 0.2) < 1e-9 && nodes.position[i][1] < 1e-9) base = i;
@@ -450,8 +449,8 @@ TEST(Saturated, PressureFilterKeepsTheUndrainedPressureUnderGravity) {
 }
 
 // Largest odd-even (checkerboard) amplitude of p_w over the nodes of a lattice block.
-double checkerboard_amplitude(const StaggeredSolver<2>& solver, double dx) {
-  const auto& nodes = solver.particles().nodes;
+double checkerboard_amplitude(const Simulation<2>& solver, double dx) {
+  const auto& nodes = solver.nodes();
   double sum = 0.0;
   for (std::size_t i = 0; i < static_cast<std::size_t>(nodes.size()); ++i) {
     const auto ix = std::lround(nodes.position[i][0] / dx), iy = std::lround(nodes.position[i][1] / dx);
@@ -493,9 +492,9 @@ cfl = 0.5
 )",
                                        fmt::arg("mixture", undrained_mixture(incremental, filter)));
   auto setup = test::case_from_string<2>(dir, text);
-  StaggeredSolver<2> solver(setup);
-  const auto& nodes = solver.particles().nodes;
-  auto& pw = solver.mutable_node_pore_pressure();
+  Simulation<2> solver(setup);
+  const auto& nodes = solver.nodes();
+  auto pw = solver.mutable_node_pore_pressure();
   for (std::size_t i = 0; i < pw.size(); ++i) {
     const auto ix = std::lround(nodes.position[i][0] / 0.1), iy = std::lround(nodes.position[i][1] / 0.1);
     pw[i] = (ix + iy) % 2 == 0 ? 1.0e3 : -1.0e3;
@@ -572,7 +571,7 @@ cfl = {}
 )",
                                          cfl);
     auto setup = test::case_from_string<2>(dir, text);
-    StaggeredSolver<2> solver(setup);
+    Simulation<2> solver(setup);
     std::string message;
     try {
       while (solver.time() < 0.02 - 1e-12) solver.step();
@@ -580,7 +579,8 @@ cfl = {}
       message = e.what();
     }
     double vmax = 0.0;
-    for (double v : solver.node_phi()) vmax = std::max(vmax, std::abs(v));
+    for (double v : values_of(solver.model().nodes.view(solver.model().fields.velocity))) vmax = std::max(vmax, std::abs(v));
+    for (double s : values_of(solver.model().nodes.view(solver.model().fields.stress))) vmax = std::max(vmax, std::abs(s));
     return std::make_pair(message, vmax);
   };
   const auto [unstable, v_unstable] = run(0.5);

@@ -11,9 +11,9 @@
 
 #include <unistd.h>
 
-#include "case/case_setup.hpp"
+#include "case/case_reader.hpp"
 #include "core/error.hpp"
-#include "solvers/staggered_solver.hpp"
+#include "schemes/simulation.hpp"
 
 namespace rktsph {
 namespace {
@@ -82,27 +82,23 @@ cfl = 0.5
 
 TEST(UniformInitialStress, IsotropicConfinementStaysUniform) {
   CaseSetup<2> setup = setup_from<2>(kSample2D, "2d");
-  StaggeredSolver<2> solver(setup);
-  constexpr int NV = StaggeredSolver<2>::NV;
+  Simulation<2> solver(setup);
   const double s0[4] = {-5.0e4, -5.0e4, -5.0e4, 0.0};
   for (int n = 0; n < 500; ++n) solver.step();
-  const auto& phi = solver.node_phi();
-  const std::size_t nn = phi.size() / NV;
+  const auto velocity = solver.node_velocity();
+  const auto stress = solver.node_stress();
+  const auto nn = solver.nodes().position.size();
   double ds = 0.0, v = 0.0;
   for (std::size_t i = 0; i < nn; ++i) {
-    for (int c = 0; c < 2; ++c) v = std::max(v, std::abs(phi[i * NV + static_cast<std::size_t>(c)]));
-    for (int c = 0; c < 4; ++c) ds = std::max(ds, std::abs(phi[i * NV + 2 + static_cast<std::size_t>(c)] - s0[c]));
+    for (int c = 0; c < 2; ++c) v = std::max(v, std::abs(velocity(i, c)));
+    for (int c = 0; c < 4; ++c) ds = std::max(ds, std::abs(stress[i][c] - s0[c]));
   }
   EXPECT_LT(ds / 5.0e4, 1e-9);
   EXPECT_LT(v, 1e-12);
   // p_c is the given p_c0 everywhere and no flow occurred inside the surface (OCR 8).
-  const auto& names = solver.history_names();
-  for (std::size_t j = 0; j < names.size(); ++j) {
-    const int sl = solver.history_slot(0, j);
-    for (std::size_t i = 0; i < nn; ++i) {
-      const double k = solver.node_history()[i * static_cast<std::size_t>(solver.history_stride()) + static_cast<std::size_t>(sl)];
-      EXPECT_EQ(k, names[j] == "p_c" ? 4.0e5 : 0.0) << names[j];
-    }
+  for (const std::string& name : solver.history_layout().names()) {
+    const HistoryView k = solver.node_history(name);
+    for (std::size_t i = 0; i < nn; ++i) EXPECT_EQ(k(i), name == "p_c" ? 4.0e5 : 0.0) << name;
   }
 }
 
@@ -135,21 +131,21 @@ end = 1.0
 cfl = 0.5
 )";
   CaseSetup<1> setup = setup_from<1>(bar, "bar");
-  StaggeredSolver<1> solver(setup);
+  Simulation<1> solver(setup);
   // Bar wave speed sqrt(E/rho), not the P-wave speed of uniaxial strain.
   EXPECT_NEAR(solver.max_wave_speed(), std::sqrt(1.0e7 / 2000.0), 1e-9);
   // A velocity field v = a x gives sigma_xx rate E a and no lateral stress.
-  auto& phi = solver.mutable_node_phi();
-  constexpr int NV = StaggeredSolver<1>::NV;
-  const auto& nodes = solver.particles().nodes;
-  for (std::size_t i = 0; i < phi.size() / NV; ++i) phi[i * NV] = 1e-3 * nodes.position[i][0];
+  auto v = solver.mutable_node_velocity();
+  const auto& nodes = solver.nodes();
+  for (std::size_t i = 0; i < nodes.position.size(); ++i) v(i, 0) = 1e-3 * nodes.position[i][0];
   solver.step();
-  for (std::size_t i = 0; i < phi.size() / NV; ++i) {
-    EXPECT_EQ(solver.node_phi()[i * NV + 2], 0.0);
-    EXPECT_EQ(solver.node_phi()[i * NV + 3], 0.0);
+  for (std::size_t i = 0; i < nodes.position.size(); ++i) {
+    EXPECT_EQ(solver.node_stress()(i, StressComponent::yy), 0.0);
+    EXPECT_EQ(solver.node_stress()(i, StressComponent::zz), 0.0);
   }
   const std::size_t mid = 5;
-  EXPECT_NEAR(solver.node_phi()[mid * NV + 1], 1.0e7 * 1e-3 * solver.dt(), 1e-6 * 1.0e7 * 1e-3 * solver.dt());
+  EXPECT_NEAR(solver.node_stress()(mid, StressComponent::xx), 1.0e7 * 1e-3 * solver.dt(),
+              1e-6 * 1.0e7 * 1e-3 * solver.dt());
 }
 
 }  // namespace

@@ -15,7 +15,7 @@
 #include <sys/wait.h>
 #include <vector>
 
-#include "case/case_setup.hpp"
+#include "case/case_reader.hpp"
 
 namespace rktsph::test {
 

@@ -2,7 +2,7 @@
 // solvers grab a matrix (the outer-index pointer of a possibly empty matrix, SparseRef.h); the
 // suppression must cover the header locations, hence before every include.
 #pragma GCC diagnostic ignored "-Wnull-dereference"
-#include "solvers/pore_pressure.hpp"
+#include "linear_solvers/pore_pressure.hpp"
 
 #include <chrono>
 #include <cmath>
@@ -117,7 +117,7 @@ PorePressureSolver::PorePressureSolver(const Sparse& full, const Sparse& symmetr
   impl_->p_all.resize(static_cast<Eigen::Index>(n));
   impl_->p_d.resize(nd);
   if (nf == 0) return;
-  // K and its preconditioner are factorised once (METHOD.md §2.4 "Solver").
+  // K and its preconditioner are factorised once (method-notes §2.4 "Solver").
   auto prepare = [&](auto& cg, const char* what) {
     cg.setTolerance(settings.tolerance);
     cg.setMaxIterations(settings.max_iterations);
@@ -134,8 +134,7 @@ PorePressureSolver::PorePressureSolver(const Sparse& full, const Sparse& symmetr
   }
 }
 
-void PorePressureSolver::solve(const std::vector<double>& source, const std::vector<double>& p_old,
-                               std::vector<double>& p) {
+void PorePressureSolver::solve(std::span<const double> source, std::span<const double> p_old, std::span<double> p) {
   const auto t0 = std::chrono::steady_clock::now();
   const auto nf = static_cast<Eigen::Index>(free_.size());
   if (nf == 0) return;

@@ -1,16 +1,17 @@
 #pragma once
-// The pore-pressure step of the V3 fractional-step scheme (METHOD.md §2.4 step 2, §5.3):
+// The pore-pressure step of the V3 fractional-step scheme (method-notes §2.4 step 2, §5.3):
 //
 //   p^{n+1}/(Q* dt) - k_eff L p^{n+1} = p^n/(Q* dt) - S_w div v*,   k_eff = k_w + S_w dt / rho,
 //
 // on the nodes, with L the corrected Laplacian of operators/laplacian.hpp. The matrix
 // K = I/(Q* dt) - k_eff S uses the symmetric part S of L, so K is symmetric positive definite;
-// the rest, k_eff (L - S) p^n, is deferred to the right-hand side (METHOD.md §3.5, §6 item 8).
+// the rest, k_eff (L - S) p^n, is deferred to the right-hand side (method-notes §3.5, §6 item 8).
 // Drained nodes (p prescribed) are eliminated symmetrically: their rows and columns leave K and
 // the known values move to the right-hand side. K and its preconditioner are built once (the
 // particles do not move and dt is fixed); each step is one Eigen::ConjugateGradient solve
 // started from p^n. Nothing here is a hand-written Krylov method.
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -46,7 +47,7 @@ class PorePressureSolver {
     /// Incremental projection: the coefficient c = S_w dt/rho of the stabilisation; solve() then
     /// adds -c L p^n (-c S p^n without the deferred correction, which then uses k_w alone) to
     /// the right-hand side, and the caller adds S_w dt div(grad p^n / rho) to `source`, so that
-    /// the stabilisation acts on p^{n+1} - p^n only. 0 = non-incremental (METHOD.md §2.4).
+    /// the stabilisation acts on p^{n+1} - p^n only. 0 = non-incremental (method-notes §2.4).
     double incremental = 0.0;
     /// Coefficient tau (m^3 s/kg) of the linear-exact pressure filter tau (S_f p^{n+1} - (T G)_f
     /// p^n) (operators/laplacian.hpp, build_filter_gradient_part); 0 = none. Needs set_filter().
@@ -65,7 +66,7 @@ class PorePressureSolver {
   /// One step: `p` holds p^n on entry (with the drained nodes already set to their values at
   /// t^{n+1}) and p^{n+1} on exit. `source[I]` = p^n_I/(Q* dt) - S_w (div v*)_I. Throws
   /// SolverError if the conjugate gradient does not converge.
-  void solve(const std::vector<double>& source, const std::vector<double>& p_old, std::vector<double>& p);
+  void solve(std::span<const double> source, std::span<const double> p_old, std::span<double> p);
 
   const PressureSolveStats& stats() const { return stats_; }
   Index unknowns() const { return static_cast<Index>(free_.size()); }

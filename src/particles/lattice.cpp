@@ -1,4 +1,4 @@
-#include "geometry/particles.hpp"
+#include "particles/lattice.hpp"
 
 #include <cmath>
 #include <limits>
@@ -63,10 +63,10 @@ void for_each_index(const std::array<int, Dim>& lo, const std::array<int, Dim>& 
 }  // namespace
 
 template <int Dim>
-Discretisation<Dim> discretise(const std::vector<Block<Dim>>& blocks, double dx,
-                               const Vec<Dim>& origin, const std::vector<double>& densities) {
+LatticeParticles<Dim> generate_lattice(const std::vector<Block<Dim>>& blocks, double dx, const Vec<Dim>& origin,
+                                       const std::vector<double>& densities) {
   if (blocks.empty()) throw InputError("the geometry has no block");
-  Discretisation<Dim> out;
+  LatticeParticles<Dim> out;
   out.dx = dx;
   Lattice<Dim>& lat = out.lattice;
   lat.dx = dx;
@@ -114,7 +114,7 @@ Discretisation<Dim> discretise(const std::vector<Block<Dim>>& blocks, double dx,
   const double corner_share = cell_volume / static_cast<double>(1 << Dim);
   const double face_share = cell_volume / dx / static_cast<double>(1 << (Dim - 1));
 
-  // Elements: one per occupied cell, at its centre (METHOD.md §3.3).
+  // Stress points: one per occupied cell, at its centre (method-notes §3.3).
   std::array<int, Dim> zero{};
   zero.fill(0);
   for_each_index<Dim>(zero, lat.cells, [&](const std::array<int, Dim>& c) {
@@ -124,13 +124,11 @@ Discretisation<Dim> discretise(const std::vector<Block<Dim>>& blocks, double dx,
     for (std::size_t d = 0; d < Dim; ++d) {
       x[static_cast<int>(d)] = lat.origin[static_cast<int>(d)] + (c[d] + 0.5) * dx;
     }
-    out.elements.position.push_back(x);
-    out.elements.volume.push_back(cell_volume);
-    out.elements.density.push_back(densities[static_cast<std::size_t>(m)]);
-    out.elements.material.push_back(m);
+    out.stress_points.add(x, cell_volume, densities[static_cast<std::size_t>(m)], m);
   });
 
   // Nodes: every lattice vertex touching an occupied cell, with its tributary volume.
+
   std::array<int, Dim> nodes_hi;
   for (std::size_t d = 0; d < Dim; ++d) nodes_hi[d] = lat.cells[d] + 1;
   for_each_index<Dim>(zero, nodes_hi, [&](const std::array<int, Dim>& v) {
@@ -185,13 +183,12 @@ Discretisation<Dim> discretise(const std::vector<Block<Dim>>& blocks, double dx,
         area[2 * d + 1] = present_side[2 * d] * face_share;
       }
     }
-    out.nodes.position.push_back(x);
-    out.nodes.volume.push_back(volume);
-    out.nodes.density.push_back(mass / volume);  // mass-weighted at material interfaces
-    out.nodes.material.push_back(material);
-    out.boundary.faces.push_back(faces);
-    out.boundary.area.push_back(area);
-    out.node_lattice_index.push_back(v);
+    if (faces != 0) {
+      out.boundary.node.push_back(out.nodes.size());
+      out.boundary.faces.push_back(faces);
+      out.boundary.area.push_back(area);
+    }
+    out.nodes.add(x, volume, mass / volume, material);  // density mass-weighted at material interfaces
   });
   return out;
 }
@@ -199,11 +196,11 @@ Discretisation<Dim> discretise(const std::vector<Block<Dim>>& blocks, double dx,
 template struct Lattice<1>;
 template struct Lattice<2>;
 template struct Lattice<3>;
-template Discretisation<1> discretise<1>(const std::vector<Block<1>>&, double, const Vec<1>&,
-                                         const std::vector<double>&);
-template Discretisation<2> discretise<2>(const std::vector<Block<2>>&, double, const Vec<2>&,
-                                         const std::vector<double>&);
-template Discretisation<3> discretise<3>(const std::vector<Block<3>>&, double, const Vec<3>&,
-                                         const std::vector<double>&);
+template LatticeParticles<1> generate_lattice<1>(const std::vector<Block<1>>&, double, const Vec<1>&,
+                                                 const std::vector<double>&);
+template LatticeParticles<2> generate_lattice<2>(const std::vector<Block<2>>&, double, const Vec<2>&,
+                                                 const std::vector<double>&);
+template LatticeParticles<3> generate_lattice<3>(const std::vector<Block<3>>&, double, const Vec<3>&,
+                                                 const std::vector<double>&);
 
 }  // namespace rktsph

@@ -1,4 +1,4 @@
-// discretise(): nodes at lattice vertices with tributary volumes, elements at cell centres,
+// generate_lattice(): nodes at lattice vertices with tributary volumes, stress points at cell centres,
 // boundary face flags and face areas (METHOD.md §3.3).
 #include <gtest/gtest.h>
 
@@ -6,7 +6,7 @@
 #include <numeric>
 
 #include "core/error.hpp"
-#include "geometry/particles.hpp"
+#include "particles/lattice.hpp"
 
 namespace rktsph {
 namespace {
@@ -14,7 +14,7 @@ namespace {
 constexpr std::uint8_t kMinusX = 1u << 0, kPlusX = 1u << 1, kMinusY = 1u << 2, kPlusY = 1u << 3;
 
 // L-shape: [0,4]x[0,2] plus [0,2]x[2,4] (area 12 m^2), dx = 0.5.
-Discretisation<2> l_shape(double dx = 0.5) {
+LatticeParticles<2> l_shape(double dx = 0.5) {
   Block<2> a, b;
   a.min = Vec<2>(0, 0);
   a.max = Vec<2>(4, 2);
@@ -22,10 +22,10 @@ Discretisation<2> l_shape(double dx = 0.5) {
   b.min = Vec<2>(0, 2);
   b.max = Vec<2>(2, 4);
   b.label = "geometry.block[1]";
-  return discretise<2>({a, b}, dx, Vec<2>(0, 0), {2000.0});
+  return generate_lattice<2>({a, b}, dx, Vec<2>(0, 0), {2000.0});
 }
 
-Index find_node(const Discretisation<2>& d, double x, double y) {
+Index find_node(const LatticeParticles<2>& d, double x, double y) {
   for (Index i = 0; i < d.nodes.size(); ++i) {
     const auto& p = d.nodes.position[static_cast<std::size_t>(i)];
     if (std::abs(p[0] - x) < 1e-12 && std::abs(p[1] - y) < 1e-12) return i;
@@ -38,15 +38,15 @@ TEST(Discretise, CountsAndTotalVolumesOfAnLShape) {
   const double dx = 0.5;
   const auto d = l_shape(dx);
   // cells: 8x4 + 4x4 = 48; nodes: 9x5 + 5x4 (rows y = 2.5..4) = 65.
-  EXPECT_EQ(d.elements.size(), 48);
+  EXPECT_EQ(d.stress_points.size(), 48);
   EXPECT_EQ(d.nodes.size(), 65);
   const double vn = std::accumulate(d.nodes.volume.begin(), d.nodes.volume.end(), 0.0);
-  const double ve = std::accumulate(d.elements.volume.begin(), d.elements.volume.end(), 0.0);
+  const double ve = std::accumulate(d.stress_points.volume.begin(), d.stress_points.volume.end(), 0.0);
   EXPECT_NEAR(vn, 12.0, 1e-12);
   EXPECT_NEAR(ve, 12.0, 1e-12);
-  for (double v : d.elements.volume) EXPECT_DOUBLE_EQ(v, dx * dx);
+  for (double v : d.stress_points.volume) EXPECT_DOUBLE_EQ(v, dx * dx);
   // Elements sit at cell centres, strictly inside the body.
-  for (const auto& x : d.elements.position) {
+  for (const auto& x : d.stress_points.position) {
     const double fx = x[0] / dx - std::floor(x[0] / dx), fy = x[1] / dx - std::floor(x[1] / dx);
     EXPECT_NEAR(fx, 0.5, 1e-12);
     EXPECT_NEAR(fy, 0.5, 1e-12);
@@ -55,7 +55,7 @@ TEST(Discretise, CountsAndTotalVolumesOfAnLShape) {
   // Mass: each set carries the whole mass.
   double mn = 0.0, me = 0.0;
   for (Index i = 0; i < d.nodes.size(); ++i) mn += d.nodes.mass(i);
-  for (Index i = 0; i < d.elements.size(); ++i) me += d.elements.mass(i);
+  for (Index i = 0; i < d.stress_points.size(); ++i) me += d.stress_points.mass(i);
   EXPECT_NEAR(mn, 12.0 * 2000.0, 1e-8);
   EXPECT_NEAR(me, 12.0 * 2000.0, 1e-8);
 }
@@ -81,8 +81,9 @@ TEST(Discretise, TributaryVolumes) {
 TEST(Discretise, FaceFlagsAndAreas) {
   const double dx = 0.5;
   const auto d = l_shape(dx);
-  auto faces = [&](double x, double y) { return d.boundary.faces[static_cast<std::size_t>(find_node(d, x, y))]; };
-  auto area = [&](double x, double y) { return d.boundary.area[static_cast<std::size_t>(find_node(d, x, y))]; };
+  const auto dense = d.boundary.dense_faces(d.nodes.size());
+  auto faces = [&](double x, double y) { return dense[static_cast<std::size_t>(find_node(d, x, y))]; };
+  auto area = [&](double x, double y) { return d.boundary.area_of(find_node(d, x, y)); };
   EXPECT_EQ(faces(1.0, 1.0), 0);
   EXPECT_EQ(faces(2.0, 1.5), 0);
   EXPECT_EQ(faces(2.0, 2.0), 0) << "a re-entrant corner lies on no face";
@@ -129,9 +130,9 @@ TEST(Discretise, OneDimensionalBar) {
   b.min = Vec<1>(-1.0);
   b.max = Vec<1>(2.0);
   b.label = "bar";
-  const auto d = discretise<1>({b}, 0.25, Vec<1>(0.0), {1500.0});
+  const auto d = generate_lattice<1>({b}, 0.25, Vec<1>(0.0), {1500.0});
   ASSERT_EQ(d.nodes.size(), 13);
-  ASSERT_EQ(d.elements.size(), 12);
+  ASSERT_EQ(d.stress_points.size(), 12);
   EXPECT_DOUBLE_EQ(d.nodes.position.front()[0], -1.0);
   EXPECT_DOUBLE_EQ(d.nodes.position.back()[0], 2.0);
   EXPECT_DOUBLE_EQ(d.nodes.volume.front(), 0.125);
@@ -139,7 +140,7 @@ TEST(Discretise, OneDimensionalBar) {
   EXPECT_EQ(d.boundary.faces.front(), kMinusX);
   EXPECT_EQ(d.boundary.faces.back(), kPlusX);
   EXPECT_DOUBLE_EQ(d.boundary.area.front()[0], 1.0);  // unit cross-section
-  EXPECT_DOUBLE_EQ(d.elements.position.front()[0], -0.875);
+  EXPECT_DOUBLE_EQ(d.stress_points.position.front()[0], -0.875);
 }
 
 TEST(Discretise, MaterialsAndInterfaceDensity) {
@@ -151,7 +152,7 @@ TEST(Discretise, MaterialsAndInterfaceDensity) {
   b.min = Vec<2>(1, 0);
   b.max = Vec<2>(2, 1);
   b.material = 1;
-  const auto d = discretise<2>({a, b}, 0.5, Vec<2>(0, 0), {1000.0, 3000.0});
+  const auto d = generate_lattice<2>({a, b}, 0.5, Vec<2>(0, 0), {1000.0, 3000.0});
   const auto i = static_cast<std::size_t>(find_node(d, 1.0, 0.5));
   EXPECT_DOUBLE_EQ(d.nodes.density[i], 2000.0);
   const auto j = static_cast<std::size_t>(find_node(d, 1.5, 0.5));
@@ -168,7 +169,7 @@ TEST(Discretise, MisalignedBlockIsAnInputErrorNamingTheBlock) {
   b.max = Vec<2>(2.3, 4);
   b.label = "case.toml, line 11, key 'geometry.block[1]'";
   try {
-    discretise<2>({a, b}, 0.5, Vec<2>(0, 0), {2000.0});
+    generate_lattice<2>({a, b}, 0.5, Vec<2>(0, 0), {2000.0});
     FAIL() << "expected an InputError";
   } catch (const InputError& e) {
     const std::string msg = e.what();
@@ -181,7 +182,7 @@ TEST(Discretise, MisalignedBlockIsAnInputErrorNamingTheBlock) {
   thin.min = Vec<2>(0, 0);
   thin.max = Vec<2>(0, 1);
   thin.label = "thin";
-  EXPECT_THROW(discretise<2>({thin}, 0.5, Vec<2>(0, 0), {2000.0}), InputError);
+  EXPECT_THROW(generate_lattice<2>({thin}, 0.5, Vec<2>(0, 0), {2000.0}), InputError);
 }
 
 }  // namespace

@@ -1,0 +1,54 @@
+#pragma once
+// Prescribed nodal components (method-notes §4.1, §0.3 items 1 and 8): boundary entries of the
+// case (regions with a velocity, a stress or both, scaled by a time function) and the
+// traction-free default on every face of the body, resolved to per-node constraints.
+//
+// The resolution runs again whenever the nodes have been reordered or have moved (resolve()):
+// a constraint is stored by node index, which is only valid for one ordering.
+#include <cstdint>
+#include <vector>
+
+#include "bc/time_function.hpp"
+#include "case/case_setup.hpp"
+#include "core/types.hpp"
+#include "particles/lattice.hpp"
+#include "particles/particle_set.hpp"
+
+namespace rktsph {
+
+/// One prescribed component at a node: the velocity along an axis (component < Dim) or a
+/// stress slot (component = Dim + slot), scaled by a time function.
+struct NodalConstraint {
+  int component = 0;
+  double value = 0.0;
+  int function = -1;
+};
+
+template <int Dim>
+class NodalConstraints {
+ public:
+  /// Resolve the case's boundary entries on the nodes. Throws InputError naming an entry that
+  /// selects no node.
+  void resolve(const std::vector<BoundarySpec<Dim>>& specs, const ParticleSet<Dim>& nodes,
+               const BoundaryNodes<Dim>& boundary, double dx);
+
+  /// Constraints of node i: list()[k] for k in [row(i), row(i + 1)), sorted by component.
+  Index begin(Index i) const { return row_[static_cast<std::size_t>(i)]; }
+  Index end(Index i) const { return row_[static_cast<std::size_t>(i) + 1]; }
+  const NodalConstraint& operator[](Index k) const { return list_[static_cast<std::size_t>(k)]; }
+  /// Nodes with at least one constraint, ascending.
+  const std::vector<Index>& constrained() const { return constrained_; }
+  /// Position of node i in constrained(), or -1.
+  Index constrained_row(Index i) const { return constrained_row_[static_cast<std::size_t>(i)]; }
+  std::size_t bytes() const {
+    return row_.size() * sizeof(Index) + list_.size() * sizeof(NodalConstraint) + constrained_row_.size() * sizeof(Index);
+  }
+
+ private:
+  std::vector<Index> row_;
+  std::vector<NodalConstraint> list_;
+  std::vector<Index> constrained_;
+  std::vector<Index> constrained_row_;
+};
+
+}  // namespace rktsph

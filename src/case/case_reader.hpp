@@ -1,0 +1,35 @@
+#pragma once
+// Reading and checking a TOML case file into a CaseSetup (docs/case-format.md). The only code
+// that knows TOML is here and in io/section.hpp. Every error names the file, the line and the
+// key, and is an InputError (exit status 2).
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <toml++/toml.h>
+
+#include "case/case_setup.hpp"
+
+namespace rktsph {
+namespace io {
+class Section;
+}
+
+/// A TOML case file, parsed, with the command-line overrides (--set key=value) applied.
+struct CaseDocument {
+  std::string file;
+  std::shared_ptr<const std::string> file_label;
+  toml::table table;
+};
+
+CaseDocument load_case_document(const std::string& file, const std::vector<std::string>& overrides);
+/// The dimension of space of a case (geometry.dimension), checked.
+int case_dimension(const CaseDocument& doc);
+
+template <int Dim>
+CaseSetup<Dim> read_case(const CaseDocument& doc);
+
+/// One [functions.NAME] table.
+TimeFunction read_time_function(const io::Section& section);
+
+}  // namespace rktsph

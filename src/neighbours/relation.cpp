@@ -1,0 +1,54 @@
+#include "neighbours/relation.hpp"
+
+#include <algorithm>
+
+namespace rktsph {
+
+namespace {
+// Targets per block: each block collects its rows on its own, then the blocks are joined in order.
+constexpr Index kRelationBlock = 1024;
+}  // namespace
+
+template <int Dim>
+void Relation<Dim>::build(const std::vector<Vec<Dim>>& targets, const std::vector<Vec<Dim>>& sources,
+                          const RelationOptions& options, const exec::Threads& policy) {
+  options_ = options;
+  const CellList<Dim> cells(sources, options.radius, options.subdivisions);
+  const auto nt = static_cast<Index>(targets.size());
+  const Index nblocks = (nt + kRelationBlock - 1) / kRelationBlock;
+  std::vector<std::vector<Index>> block_indices(static_cast<std::size_t>(nblocks));
+  std::vector<Index> counts(static_cast<std::size_t>(nt));
+  const double r2 = options.radius * options.radius;
+  exec::particle_for(
+      policy, nblocks,
+      [&](Index blk) {
+        std::vector<typename CellList<Dim>::Hit> hits;
+        std::vector<Index> row;
+        auto& out = block_indices[static_cast<std::size_t>(blk)];
+        const Index end = std::min(nt, (blk + 1) * kRelationBlock);
+        for (Index a = blk * kRelationBlock; a < end; ++a) {
+          const std::size_t n = cells.collect(targets[static_cast<std::size_t>(a)], r2, hits);
+          row.resize(n);
+          for (std::size_t k = 0; k < n; ++k) row[k] = hits[k].j;
+          if (options.sorted) std::sort(row.begin(), row.end());
+          out.insert(out.end(), row.begin(), row.end());
+          counts[static_cast<std::size_t>(a)] = static_cast<Index>(n);
+        }
+      },
+      exec::Schedule::dynamic, nt);
+  offsets_.assign(static_cast<std::size_t>(nt) + 1, 0);
+  for (Index a = 0; a < nt; ++a) offsets_[static_cast<std::size_t>(a) + 1] = offsets_[static_cast<std::size_t>(a)] + counts[static_cast<std::size_t>(a)];
+  indices_.clear();
+  indices_.reserve(static_cast<std::size_t>(offsets_.back()));
+  for (auto& b : block_indices) {
+    indices_.insert(indices_.end(), b.begin(), b.end());
+    b = {};
+  }
+  ++version_;
+}
+
+template class Relation<1>;
+template class Relation<2>;
+template class Relation<3>;
+
+}  // namespace rktsph

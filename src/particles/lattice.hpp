@@ -1,0 +1,99 @@
+#pragma once
+// The lattice generator of the two interleaved particle sets of the staggered scheme
+// (method-notes §3.3):
+//   nodes         - the vertices of a cell lattice; they carry the persistent state at t^n;
+//   stress points - one per lattice cell, at its centre; they carry the half-step state at
+//                   t^{n+1/2}.
+// Bodies are unions of axis-aligned blocks on one lattice of spacing dx. A node's volume is its
+// tributary volume (dx^d inside, half on an edge, a quarter at a corner), so that each set
+// carries the whole mass on its own.
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "core/types.hpp"
+#include "particles/particle_set.hpp"
+
+namespace rktsph {
+
+/// A block of cells of one material: [min, max] must lie on the lattice.
+template <int Dim>
+struct Block {
+  Vec<Dim> min;
+  Vec<Dim> max;
+  int material = 0;
+  std::string label;  // for error messages ("geometry.block[0]")
+};
+
+/// The lattice of cells that holds the body; cell c occupies [origin + c*dx, origin + (c+1)*dx].
+template <int Dim>
+struct Lattice {
+  double dx = 0.0;
+  Vec<Dim> origin;
+  std::array<int, Dim> cells{};     // cells per axis of the bounding box
+  std::vector<int> cell_material;   // -1 where there is no material
+
+  std::size_t cell_index(const std::array<int, Dim>& c) const;
+  /// Material of a cell, or -1 outside the lattice or for an empty cell.
+  int material_at(const std::array<int, Dim>& c) const;
+};
+
+/// The nodes on the faces of the body, with the faces each lies on (bit 2d of `faces`: the face
+/// with outward normal -e_d; bit 2d+1: +e_d) and its tributary area of each face, m^(Dim-1).
+/// Kept as a sorted list of node indices, not as node fields: the faces are a small part of a
+/// large set. remap() follows a reordering of the nodes.
+template <int Dim>
+struct BoundaryNodes {
+  std::vector<Index> node;  // ascending
+  std::vector<std::uint8_t> faces;
+  std::vector<std::array<double, 2 * Dim>> area;
+
+  std::size_t size() const { return node.size(); }
+  /// The face areas of node i (zeros for a node on no face).
+  std::array<double, 2 * Dim> area_of(Index i) const {
+    const auto it = std::lower_bound(node.begin(), node.end(), i);
+    if (it == node.end() || *it != i) return {};
+    return area[static_cast<std::size_t>(it - node.begin())];
+  }
+  /// The faces of every node of a set of `nodes` particles (0 inside).
+  std::vector<std::uint8_t> dense_faces(Index nodes) const {
+    std::vector<std::uint8_t> out(static_cast<std::size_t>(nodes), 0);
+    for (std::size_t k = 0; k < node.size(); ++k) out[static_cast<std::size_t>(node[k])] = faces[k];
+    return out;
+  }
+  /// After ParticleSet::permute(order): node order[k] is now node k.
+  void remap(const std::vector<Index>& order) {
+    std::vector<Index> new_index(order.size());
+    for (std::size_t k = 0; k < order.size(); ++k) new_index[static_cast<std::size_t>(order[k])] = static_cast<Index>(k);
+    std::vector<std::size_t> perm(node.size());
+    for (std::size_t k = 0; k < perm.size(); ++k) perm[k] = k;
+    for (auto& i : node) i = new_index[static_cast<std::size_t>(i)];
+    std::sort(perm.begin(), perm.end(), [&](std::size_t a, std::size_t b) { return node[a] < node[b]; });
+    BoundaryNodes out;
+    for (std::size_t k : perm) {
+      out.node.push_back(node[k]);
+      out.faces.push_back(faces[k]);
+      out.area.push_back(area[k]);
+    }
+    *this = std::move(out);
+  }
+};
+
+template <int Dim>
+struct LatticeParticles {
+  double dx = 0.0;
+  Lattice<Dim> lattice;
+  ParticleSet<Dim> nodes{"nodes"};
+  ParticleSet<Dim> stress_points{"stress_points"};
+  BoundaryNodes<Dim> boundary;
+};
+
+/// Build nodes and stress points from blocks (all on one lattice of spacing dx starting at
+/// `origin`). Throws InputError naming the block if it is not aligned with the lattice.
+template <int Dim>
+LatticeParticles<Dim> generate_lattice(const std::vector<Block<Dim>>& blocks, double dx, const Vec<Dim>& origin,
+                                       const std::vector<double>& densities);
+
+}  // namespace rktsph

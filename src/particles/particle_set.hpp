@@ -1,0 +1,190 @@
+#pragma once
+// A set of particles (docs/architecture.md, "Particle state"): the nodes and the stress points
+// of the staggered scheme are two of them (method-notes §3.3).
+//
+// Every set has mutable positions, volumes, densities, materials and global ids, and holds
+// the fields its schemes register by name (particles/field.hpp), one array per field. The
+// first owned() particles belong to this process; the rest, [owned(), size()), is room for
+// ghost copies of other processes' particles (a halo; none yet). Reordering (sorting by cell,
+// later) goes through permute(), which carries every property and field.
+#include <algorithm>
+#include <cstdint>
+#include <numeric>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "core/error.hpp"
+#include "core/types.hpp"
+#include "particles/field.hpp"
+
+namespace rktsph {
+
+template <int Dim>
+class ParticleSet {
+ public:
+  explicit ParticleSet(std::string name = "particles") : name_(std::move(name)) {}
+
+  // Properties of every particle (one entry each, all of length size()).
+  std::vector<Vec<Dim>> position;      // m
+  std::vector<double> volume;          // m^Dim (per unit thickness in 2D, per unit area in 1D)
+  std::vector<double> density;         // kg/m^3
+  std::vector<int> material;           // index into the case's materials
+  std::vector<std::int64_t> global_id;  // the same particle on every process and after sorting
+
+  const std::string& name() const { return name_; }
+  void set_name(std::string name) { name_ = std::move(name); }
+  Index size() const { return static_cast<Index>(position.size()); }
+  Index owned() const { return owned_; }
+  Index ghosts() const { return size() - owned_; }
+  double mass(Index i) const { return volume[static_cast<std::size_t>(i)] * density[static_cast<std::size_t>(i)]; }
+
+  /// Append an owned particle (generators; before any ghost is added). Fields get zeros.
+  void add(const Vec<Dim>& x, double V, double rho, int mat) {
+    if (ghosts() != 0) throw SolverError(fmt::format("{}: owned particles must come before the ghosts", name_));
+    position.push_back(x);
+    volume.push_back(V);
+    density.push_back(rho);
+    material.push_back(mat);
+    global_id.push_back(static_cast<std::int64_t>(position.size()) - 1);
+    ++owned_;
+    for (Column& c : columns_) c.resize(position.size());
+  }
+
+  /// Register a field (zero-initialised). N = 0 takes the component count from `components`.
+  template <class T, int N>
+  Field<T, N> add_field(std::string field_name, std::vector<std::string> component_names, unsigned flags,
+                        int components = N) {
+    if (find_id(field_name) >= 0) {
+      throw SolverError(fmt::format("{}: the field '{}' is registered twice", name_, field_name));
+    }
+    Column c;
+    c.info = {std::move(field_name), field_type_of<T>(), N > 0 ? N : components, std::move(component_names), flags};
+    c.resize(position.size());
+    columns_.push_back(std::move(c));
+    return Field<T, N>{static_cast<int>(columns_.size()) - 1};
+  }
+
+  /// The field named `field_name`, or an invalid handle if there is none. Throws if it exists
+  /// with another type or component count.
+  template <class T, int N>
+  Field<T, N> find(std::string_view field_name) const {
+    const int id = find_id(field_name);
+    if (id < 0) return {};
+    const FieldInfo& info = columns_[static_cast<std::size_t>(id)].info;
+    if (info.type != field_type_of<T>() || (N > 0 && info.components != N)) {
+      throw SolverError(fmt::format("{}: the field '{}' has another type or component count", name_, field_name));
+    }
+    return Field<T, N>{id};
+  }
+  bool has(std::string_view field_name) const { return find_id(field_name) >= 0; }
+
+  template <class T, int N>
+  FieldView<T, N> view(Field<T, N> f) {
+    Column& c = column(f.id);
+    return FieldView<T, N>(c.template data<T>(), size(), c.info.components);
+  }
+  template <class T, int N>
+  FieldView<const T, N> view(Field<T, N> f) const {
+    const Column& c = column(f.id);
+    return FieldView<const T, N>(const_cast<Column&>(c).template data<T>(), size(), c.info.components);
+  }
+
+  /// The declarations, in registration order (output writes them in this order).
+  std::vector<FieldInfo> fields() const {
+    std::vector<FieldInfo> out;
+    for (const Column& c : columns_) out.push_back(c.info);
+    return out;
+  }
+  const FieldInfo& info(int id) const { return column(id).info; }
+
+  /// Bytes held by the properties and the fields whose flags intersect `flags` (all by default).
+  std::size_t bytes(unsigned flags = ~0u) const {
+    std::size_t b = position.size() * sizeof(Vec<Dim>) + (volume.size() + density.size()) * sizeof(double) +
+                    material.size() * sizeof(int) + global_id.size() * sizeof(std::int64_t);
+    for (const Column& c : columns_) {
+      if ((c.info.flags & flags) != 0 || (c.info.flags == 0 && flags == ~0u)) b += c.bytes();
+    }
+    return b;
+  }
+
+  /// Reorder: particle k of the result is particle order[k] of this set (a permutation of
+  /// [0, size())). Every property and field moves with its particle.
+  void permute(const std::vector<Index>& order) {
+    if (order.size() != position.size()) throw SolverError(fmt::format("{}: permutation of the wrong size", name_));
+    apply(position, order);
+    apply(volume, order);
+    apply(density, order);
+    apply(material, order);
+    apply(global_id, order);
+    for (Column& c : columns_) {
+      const auto n = static_cast<std::size_t>(c.info.components);
+      apply_rows(c.f64, order, n);
+      apply_rows(c.u8, order, n);
+      apply_rows(c.i64, order, n);
+    }
+  }
+
+ private:
+  struct Column {
+    FieldInfo info;
+    std::vector<double> f64;
+    std::vector<std::uint8_t> u8;
+    std::vector<std::int64_t> i64;
+    void resize(std::size_t particles) {
+      const std::size_t n = particles * static_cast<std::size_t>(info.components);
+      switch (info.type) {
+        case FieldType::f64: f64.resize(n, 0.0); break;
+        case FieldType::u8: u8.resize(n, 0); break;
+        case FieldType::i64: i64.resize(n, 0); break;
+      }
+    }
+    std::size_t bytes() const {
+      return f64.size() * sizeof(double) + u8.size() * sizeof(std::uint8_t) + i64.size() * sizeof(std::int64_t);
+    }
+    template <class T>
+    T* data() {
+      if constexpr (std::is_same_v<std::remove_const_t<T>, double>) return f64.data();
+      else if constexpr (std::is_same_v<std::remove_const_t<T>, std::uint8_t>) return u8.data();
+      else return i64.data();
+    }
+  };
+
+  int find_id(std::string_view field_name) const {
+    for (std::size_t i = 0; i < columns_.size(); ++i) {
+      if (columns_[i].info.name == field_name) return static_cast<int>(i);
+    }
+    return -1;
+  }
+  Column& column(int id) {
+    if (id < 0 || id >= static_cast<int>(columns_.size())) throw SolverError(fmt::format("{}: no such field", name_));
+    return columns_[static_cast<std::size_t>(id)];
+  }
+  const Column& column(int id) const { return const_cast<ParticleSet*>(this)->column(id); }
+
+  template <class V>
+  static void apply(V& values, const std::vector<Index>& order) {
+    if (values.empty()) return;
+    V out(values.size());
+    for (std::size_t k = 0; k < order.size(); ++k) out[k] = values[static_cast<std::size_t>(order[k])];
+    values = std::move(out);
+  }
+  template <class V>
+  static void apply_rows(V& values, const std::vector<Index>& order, std::size_t n) {
+    if (values.empty()) return;
+    V out(values.size());
+    for (std::size_t k = 0; k < order.size(); ++k) {
+      std::copy_n(values.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(order[k]) * n), n,
+                  out.begin() + static_cast<std::ptrdiff_t>(k * n));
+    }
+    values = std::move(out);
+  }
+
+  std::string name_;
+  Index owned_ = 0;
+  std::vector<Column> columns_;
+};
+
+}  // namespace rktsph

@@ -1,0 +1,223 @@
+#include "schemes/pressure_stage.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "operators/laplacian.hpp"
+
+namespace rktsph {
+
+template <int Dim>
+PorePressureStage<Dim>::PorePressureStage(StaggeredModel<Dim>& model) : m_(model) {
+  const FluidSpec& fl = m_.setup.fluid;
+  const ParticleSet<Dim>& nodes = m_.nodes;
+  const auto nn = static_cast<std::size_t>(nodes.size());
+  const double dt = m_.time_step.dt;
+  pressure_ = m_.nodes.template add_field<double, 1>("pore_pressure", {"pw"}, kFieldOutput | kFieldEvolving);
+  m_.set_pore_pressure(pressure_);
+  auto pw = m_.nodes.view(pressure_);
+  p_old_.assign(nn, 0.0);
+  source_.assign(nn, 0.0);
+
+  // Pore-pressure conditions (method-notes §4.1).
+  conditions_ = resolve_pore_pressure_conditions<Dim>(m_.setup.boundaries, nodes, m_.boundary, m_.dx(),
+                                                      m_.kernel.support_radius(), m_.setup.file);
+  for (std::size_t i = 0; i < nn; ++i) {
+    pw(static_cast<Index>(i), 0) = conditions_.drained[i]
+                                       ? conditions_.value[i] * m_.function_value(conditions_.function[i], 0.0)
+                                       : fl.initial_pore_pressure;
+  }
+
+  // The undrained Courant number and the faces where it limits stability (see the header).
+  {
+    const double q = 1.0 / fl.inverse_storage();
+    double ratio = 1.0;
+    for (const ElasticRate& e : m_.materials.elastic) {
+      const double drained = e.lambda + 2.0 * e.G;
+      ratio = std::max(ratio, std::sqrt((drained + q) / drained));
+    }
+    undrained_courant_ = m_.time_step.courant * ratio;
+    impermeable_stress_faces_ = 0;
+    for (std::size_t b = 0; b < m_.boundary.size(); ++b) {
+      const Index i = m_.boundary.node[b];
+      if (conditions_.drained[static_cast<std::size_t>(i)]) continue;
+      bool exposed = false;
+      for (int d = 0; d < Dim; ++d) {
+        if ((m_.boundary.faces[b] >> (2 * d) & 3u) == 0) continue;  // not on a face normal to d
+        bool held = false;
+        for (Index k = m_.constraints.begin(i); k < m_.constraints.end(i); ++k) held = held || m_.constraints[k].component == d;
+        exposed = exposed || !held;
+      }
+      if (exposed) ++impermeable_stress_faces_;
+    }
+  }
+
+  Relation<Dim> relation;
+  relation.build(nodes.position, nodes.position, operator_relation_options(m_.kernel), m_.policy);
+  node_operator_ = build_corrected_operator<Dim>(relation, nodes.position, nodes, m_.kernel);
+  relation.build(nodes.position, nodes.position, laplacian_relation_options(m_.kernel), m_.policy);
+  const NodeLaplacian<Dim> lap =
+      build_node_laplacian<Dim>(relation, nodes, m_.kernel, {}, conditions_.planes, conditions_.mirror_mask);
+
+  // K = I/(Q* dt) - k_eff S with k_eff = k_w + S_w dt/rho (method-notes §2.4). One mixture density
+  // is assumed for the fractional-step term (the densest material: the largest stabilisation is
+  // not needed, the smallest k_eff changes little; a single K keeps it symmetric).
+  double rho = 0.0;
+  for (const auto& mat : m_.materials.models) rho = std::max(rho, mat->density());
+  inv_storage_ = fl.inverse_storage();
+  PorePressureSolver::Settings s;
+  s.inv_q_dt = inv_storage_ / dt;
+  // The stabilisation time is dt with div v* at the nodes (method-notes §2.4) and dt/2 with the
+  // stress points' half-step velocity, which carries (dt/2) grad p / rho in a quasi-static state.
+  stabilisation_time_ = fl.divergence_from_stress_points ? 0.5 * dt : dt;
+  if (fl.divergence_from_stress_points) skeleton_.assign(static_cast<std::size_t>(m_.stress_points.size()) * Dim, 0.0);
+  s.k_eff = fl.permeability() + fl.saturation * stabilisation_time_ / rho;
+  s.tolerance = fl.tolerance;
+  s.max_iterations = fl.max_iterations;
+  s.preconditioner =
+      fl.incomplete_cholesky ? PressurePreconditioner::incomplete_cholesky : PressurePreconditioner::diagonal;
+  s.deferred_correction = fl.deferred_correction;
+  if (fl.incremental) {
+    s.incremental = fl.saturation * stabilisation_time_ / rho;
+    pressure_gradient_.assign(nn * static_cast<std::size_t>(Dim), 0.0);
+  }
+  if (fl.filter > 0.0) {
+    // Linear-exact pressure filter (solver.pressure_filter, operators/laplacian.hpp): tau (S_f p -
+    // T G p) on the plain node set (no wall mirrors: psi_IJ pairs real nodes), G the corrected
+    // node gradient of the velocity correction. It damps odd-even pressure modes, which the
+    // incremental projection leaves undamped, without acting on the linear (and, inside, the
+    // quadratic) pressure fields that loads impose at impermeable walls.
+    s.filter = fl.filter * fl.saturation * stabilisation_time_ / rho;
+    const auto grad = gradient_matrices<Dim>(node_operator_, static_cast<Index>(nn));
+    const NodeLaplacian<Dim> plain = build_node_laplacian<Dim>(relation, nodes, m_.kernel);
+    const PorePressureSolver::Sparse tg = build_filter_gradient_part<Dim>(plain.symmetric, nodes.position, grad);
+    solver_ = std::make_unique<PorePressureSolver>(lap.full, lap.symmetric, conditions_.drained, s, &plain.symmetric, &tg);
+  } else {
+    solver_ = std::make_unique<PorePressureSolver>(lap.full, lap.symmetric, conditions_.drained, s);
+  }
+}
+
+template <int Dim>
+std::string PorePressureStage<Dim>::instability_hint() const {
+  if (impermeable_stress_faces_ == 0 || undrained_courant_ <= kUndrainedCourantLimit) return {};
+  return fmt::format(
+      " (V3: impermeable faces carrying a total stress are unstable above C c_u/c_d = {}; "
+      "here it is {:.2f}: time.cfl <= {:.3f})",
+      kUndrainedCourantLimit, undrained_courant_,
+      m_.time_step.courant * kUndrainedCourantLimit / undrained_courant_);
+}
+
+template <int Dim>
+std::size_t PorePressureStage<Dim>::scratch_bytes() const {
+  return (p_old_.size() + source_.size() + pressure_gradient_.size() + skeleton_.size()) * sizeof(double) +
+         node_operator_.bytes();
+}
+
+template <int Dim>
+void PorePressureStage<Dim>::run(const StepContext& context) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const double t_new = context.t + context.dt;
+  const double dt = m_.time_step.dt;
+  const Index nn = m_.nodes.size();
+  const ParticleSet<Dim>& nodes = m_.nodes;
+  const double sw = m_.setup.fluid.saturation;
+  const double inv_q_dt = inv_storage_ / dt;
+  auto pw_view = m_.nodes.view(pressure_);
+  std::vector<double>& pw_old = p_old_;
+  std::copy(pw_view.data(), pw_view.data() + nn, pw_old.begin());
+  const CorrectedOperator<Dim>& op = node_operator_;
+  const Index* base = op.base.data();
+  const Index* pat = op.pattern.data();
+  const Index* pstart = op.pattern_start.data();
+  const Index* off = op.offset.data();
+  const auto* wg = op.grad.data();
+  auto v = m_.nodes.view(m_.fields.velocity);
+  double* pw = pw_view.data();
+  // Same-set corrected gradient of a nodal scalar at node i (that of the velocity correction).
+  auto node_gradient = [&](const double* f, Index i, double (&g)[Dim]) {
+    for (int d = 0; d < Dim; ++d) g[d] = 0.0;
+    for (Index k = pstart[pat[i]]; k < pstart[pat[i] + 1]; ++k) {
+      const double fk = f[static_cast<std::size_t>(base[i] + off[k])];
+      for (int d = 0; d < Dim; ++d) g[d] += wg[k][static_cast<std::size_t>(d)] * fk;
+    }
+  };
+  // RHS_I = p^n_I/(Q* dt) - S_w (div v*)_I; drained nodes take their value at t^{n+1}.
+  //
+  // solver.pressure_divergence = "stress_points": div of the stress points' pressure-free half-
+  // step velocity v~_E = P_EN v^n + (dt/2)(div sigma'/rho + b), gradient back to the nodes, with
+  // the stabilisation S_w (dt/2)/rho in K. In a quasi-static state v~ = v + (dt/2) grad p/rho,
+  // so the two (dt/2) terms cancel as the dt terms of method-notes §2.4 do; and when the stress
+  // points are at rest the source is (dt/2) div grad p/rho, cancelled by K, so p_w drains to
+  // zero. With div v* at the nodes it does not where a load jumps (a footing edge): there the
+  // nodes keep an O(dt) velocity in the steady state that no stress point sees (method-notes
+  // §0.3 item 8), and its divergence feeds a steady Darcy flow (Case 15: 0.2 sigma0 that never
+  // drains). Half the stabilisation damps odd-even pressure modes less (Case 16).
+  const bool from_stress_points = !skeleton_.empty();
+  const CorrectedOperator<Dim>& to_nodes = m_.to_nodes;
+  const FieldView<const double, Dim> skeleton(skeleton_.data(), m_.stress_points.size(), Dim);
+  exec::particle_for(m_.policy, nn, [&](Index i) {
+    const auto iu = static_cast<std::size_t>(i);
+    double div = 0.0;
+    if (from_stress_points) {
+      const auto r = to_nodes.row(i);
+      for (Index k = r.begin; k < r.end; ++k) {
+        const double* ve = skeleton[to_nodes.source(r, k)];
+        for (int d = 0; d < Dim; ++d) div += to_nodes.grad[static_cast<std::size_t>(k)][static_cast<std::size_t>(d)] * ve[d];
+      }
+    } else {
+      for (Index k = pstart[pat[i]]; k < pstart[pat[i] + 1]; ++k) {
+        const double* vk = v[base[i] + off[k]];
+        for (int d = 0; d < Dim; ++d) div += wg[k][static_cast<std::size_t>(d)] * vk[d];
+      }
+    }
+    source_[iu] = pw_old[iu] * inv_q_dt - sw * div;
+    if (conditions_.drained[iu]) pw[iu] = conditions_.value[iu] * m_.function_value(conditions_.function[iu], t_new);
+  });
+  if (!pressure_gradient_.empty()) {
+    // Incremental projection (solver.pressure_incremental): add S_w dt div(grad p^n / rho) to the
+    // source; the solver subtracts S_w (dt/rho) L p^n, so the stabilisation acts on p^{n+1} - p^n.
+    // At a static state (v^{n+1} = 0) the pressure equation then reduces to k_w L p = 0: the
+    // mirror (impermeable) rows of L no longer constrain the hydrostatic-like gradient that
+    // carries the load, which in the non-incremental form leaks pore pressure through the walls.
+    FieldView<double, Dim> grad(pressure_gradient_.data(), nn, Dim);
+    exec::particle_for(m_.policy, nn, [&](Index i) {
+      double g[Dim];
+      node_gradient(pw_old.data(), i, g);
+      for (int d = 0; d < Dim; ++d) grad(i, d) = g[d] / nodes.density[static_cast<std::size_t>(i)];
+    });
+    // A prescribed velocity component is not corrected (the constraints reset it), so it
+    // carries no pressure-gradient term in v* - (dt/rho) grad p^n either.
+    for (const Index i : m_.constraints.constrained()) {
+      for (Index k = m_.constraints.begin(i); k < m_.constraints.end(i); ++k) {
+        const NodalConstraint& c = m_.constraints[k];
+        if (c.component < Dim) grad(i, c.component) = 0.0;
+      }
+    }
+    exec::particle_for(m_.policy, nn, [&](Index i) {
+      double div = 0.0;
+      for (Index k = pstart[pat[i]]; k < pstart[pat[i] + 1]; ++k) {
+        const double* g = grad[base[i] + off[k]];
+        for (int d = 0; d < Dim; ++d) div += wg[k][static_cast<std::size_t>(d)] * g[d];
+      }
+      source_[static_cast<std::size_t>(i)] += sw * stabilisation_time_ * div;
+    });
+  }
+  solver_->solve(source_, pw_old, {pw, static_cast<std::size_t>(nn)});
+  // Velocity correction v^{n+1} = v* - (dt/rho) grad p^{n+1} (same-set corrected gradient).
+  exec::particle_for(m_.policy, nn, [&](Index i) {
+    double g[Dim];
+    node_gradient(pw, i, g);
+    const double f = dt / nodes.density[static_cast<std::size_t>(i)];
+    for (int d = 0; d < Dim; ++d) v(i, d) -= f * g[d];
+  });
+  seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+template class PorePressureStage<1>;
+template class PorePressureStage<2>;
+template class PorePressureStage<3>;
+
+}  // namespace rktsph

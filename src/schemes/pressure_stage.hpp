@@ -1,0 +1,69 @@
+#pragma once
+// The pressure stage of the saturated v-p_w scheme V3 (method-notes §1.4, §2.4, §5.3): after
+// V1's explicit steps have given v* and sigma' at the nodes, solve the storage equation
+//   K p^{n+1} = p^n/(Q* dt) - S_w div v* (+ the stabilisation, filter and drained terms)
+// by preconditioned conjugate gradient (linear_solvers/pore_pressure.hpp), then correct the velocity
+// v^{n+1} = v* - (dt/rho) grad p^{n+1}.
+#include <memory>
+#include <vector>
+
+#include "bc/pore_pressure_conditions.hpp"
+#include "schemes/stage.hpp"
+#include "schemes/staggered_model.hpp"
+#include "linear_solvers/pore_pressure.hpp"
+
+namespace rktsph {
+
+template <int Dim>
+class PorePressureStage final : public Stage {
+ public:
+  /// Registers the node field "pore_pressure" (the model then works with total stresses at
+  /// the constraints), resolves the pore-pressure conditions and builds the pressure equation.
+  explicit PorePressureStage(StaggeredModel<Dim>& model);
+
+  std::string_view name() const override { return "pore_pressure"; }
+  void run(const StepContext& context) override;
+  std::size_t scratch_bytes() const override;
+
+  Field<double, 1> pore_pressure() const { return pressure_; }
+  /// The stress points' pressure-free half-step velocity (solver.pressure_divergence =
+  /// "stress_points"), filled by step 1; empty otherwise.
+  FieldView<double, Dim> skeleton_velocity() {
+    return skeleton_.empty() ? FieldView<double, Dim>() : FieldView<double, Dim>(skeleton_.data(), m_.stress_points.size(), Dim);
+  }
+  /// 1/Q*, 1/Pa.
+  double inverse_storage() const { return inv_storage_; }
+
+  const PressureSolveStats& stats() const { return solver_->stats(); }
+  const PorePressureSolver& solver() const { return *solver_; }
+  /// Wall time of the whole stage (divergence, solve, velocity correction), s.
+  double seconds() const { return seconds_; }
+
+  /// C c_u / c_d, the Courant number of the undrained P wave (c_u^2 = (lambda + 2G + Q)/rho),
+  /// largest over the materials, and the number of boundary nodes that are neither drained nor
+  /// held in their normal direction (impermeable faces carrying a prescribed, possibly zero,
+  /// total stress). The step is unstable at such faces once that Courant number exceeds
+  /// kUndrainedCourantLimit (docs/VALIDATION.md, Case 16).
+  double undrained_courant() const { return undrained_courant_; }
+  Index impermeable_stress_face_nodes() const { return impermeable_stress_faces_; }
+  static constexpr double kUndrainedCourantLimit = 3.5;
+  /// The growth guard's hint when the limit above is exceeded (empty otherwise).
+  std::string instability_hint() const;
+
+ private:
+  StaggeredModel<Dim>& m_;
+  Field<double, 1> pressure_;
+  PorePressureConditions conditions_;
+  CorrectedOperator<Dim> node_operator_;  // nodes -> nodes: div v*, grad p
+  std::unique_ptr<PorePressureSolver> solver_;
+  std::vector<double> p_old_, source_;
+  std::vector<double> pressure_gradient_;  // incremental projection: grad p^n / rho (Dim per node)
+  std::vector<double> skeleton_;           // pressure-free half-step velocity (Dim per stress point)
+  double inv_storage_ = 0.0;
+  double stabilisation_time_ = 0.0;  // dt (method-notes §2.4) or dt/2 (stress-point divergence)
+  double undrained_courant_ = 0.0;
+  Index impermeable_stress_faces_ = 0;
+  double seconds_ = 0.0;
+};
+
+}  // namespace rktsph

@@ -1,0 +1,141 @@
+#include "schemes/simulation.hpp"
+
+#include <cmath>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "core/error.hpp"
+#include "schemes/registry.hpp"
+#include "schemes/staggered_stages.hpp"
+
+namespace rktsph {
+
+template <int Dim>
+Simulation<Dim>::Simulation(CaseSetup<Dim> setup, exec::Threads policy)
+    : model_(std::make_unique<StaggeredModel<Dim>>(std::move(setup), policy)),
+      scheme_(create_scheme<Dim>(model_->setup.version, *model_)),
+      clock_(model_->setup, model_->time_step) {
+  model_->set_initial_state();
+  clock_.start(energy().strain, model_->boundary_power(), balance_sums());
+}
+
+template <int Dim>
+StepSums<Dim> Simulation<Dim>::balance_sums() {
+  const ParticleSet<Dim>& nodes = model_->nodes;
+  const auto v = nodes.view(model_->fields.velocity);
+  return exec::particle_reduce<Dim + 2>(model_->policy, nodes.size(), reduction_, [&](Index i, double* sums) {
+    const auto iu = static_cast<std::size_t>(i);
+    const double m = nodes.volume[iu] * nodes.density[iu];
+    for (int d = 0; d < Dim; ++d) {
+      const double vd = v(i, d);
+      sums[d] += m * vd;
+      sums[Dim] += m * vd * vd;
+      if (!std::isfinite(vd)) sums[Dim + 1] = 1.0;
+    }
+  });
+}
+
+template <int Dim>
+void Simulation<Dim>::step() {
+  const double t = clock_.time();
+  if (clock_.steps() == 0) {
+    const EnergyBalance e0 = energy();
+    clock_.set_initial_energy(e0.kinetic + std::abs(e0.strain));
+  }
+  StepContext context;
+  context.t = t;
+  context.dt = clock_.dt();
+  context.damping = clock_.damping_at(t);
+  scheme_->run(context);
+
+  const StepSums<Dim> sums = balance_sums();
+  if (sums[Dim + 1] != 0.0) {
+    const auto v = nodes().view(model_->fields.velocity);
+    const auto s = nodes().view(model_->fields.stress);
+    Index bad = 0;
+    for (Index i = 0; i < nodes().size(); ++i) {
+      bool finite = true;
+      for (int d = 0; d < Dim; ++d) finite = finite && std::isfinite(v(i, d));
+      for (int c = 0; c < kStressComponents<Dim>; ++c) finite = finite && std::isfinite(s(i, c));
+      if (!finite) {
+        bad = i;
+        break;
+      }
+    }
+    const auto& x = nodes().position[static_cast<std::size_t>(bad)];
+    throw SolverError(fmt::format(
+        "the solution became non-finite at step {} (t = {:.6g} s), first at node {} (x = [{}]); "
+        "the run is unstable: reduce the time step (time.cfl = {:.3g}) or check the loads and "
+        "material parameters",
+        clock_.steps() + 1, t + clock_.dt(), bad, fmt::join(x.data(), x.data() + Dim, ", "), clock_.courant()));
+  }
+  clock_.end_step(sums, model_->boundary_power(), scheme_->instability_hint ? scheme_->instability_hint() : std::string());
+}
+
+template <int Dim>
+EnergyBalance Simulation<Dim>::energy() const {
+  EnergyBalance e;
+  const ParticleSet<Dim>& nodes = model_->nodes;
+  const auto v = nodes.view(model_->fields.velocity);
+  const auto s = nodes.view(model_->fields.stress);
+  const auto& stored = scheme_->stored_energy_density;
+  for (Index i = 0; i < nodes.size(); ++i) {
+    const auto iu = static_cast<std::size_t>(i);
+    const double m = nodes.mass(i);
+    for (int d = 0; d < Dim; ++d) e.kinetic += 0.5 * m * v(i, d) * v(i, d);
+    const Sym6 sig = to_sym6<Dim>(s[i]);
+    const Sym6 eps = model_->materials[nodes.material[iu]].elastic().apply_inverse(sig);
+    double w = 0.0;
+    for (std::size_t c = 0; c < 3; ++c) w += sig[c] * eps[c];
+    for (std::size_t c = 3; c < 6; ++c) w += 2.0 * sig[c] * eps[c];
+    if (stored) w += stored(i);  // V3: fluid storage p^2/(2Q*)
+    e.strain += 0.5 * nodes.volume[iu] * w;
+  }
+  e.external_work = clock_.external_work();
+  e.damping_loss = clock_.damping_loss();
+  e.initial_strain = clock_.initial_strain();
+  return e;
+}
+
+template <int Dim>
+std::span<const double> Simulation<Dim>::node_pore_pressure() const {
+  if (!saturated()) return {};
+  const auto p = nodes().view(model_->fields.pore_pressure);
+  return {p.data(), static_cast<std::size_t>(p.size())};
+}
+
+template <int Dim>
+std::span<double> Simulation<Dim>::mutable_node_pore_pressure() {
+  if (!saturated()) return {};
+  auto p = model_->nodes.view(model_->fields.pore_pressure);
+  return {p.data(), static_cast<std::size_t>(p.size())};
+}
+
+template <int Dim>
+HistoryView Simulation<Dim>::node_history(std::string_view name) const {
+  const int k = history_layout().find(name);
+  if (k < 0) throw SolverError(fmt::format("no material of this case has the history variable '{}'", name));
+  return HistoryView(nodes().view(model_->fields.history), history_layout(), nodes().material, k);
+}
+
+template <int Dim>
+HistoryView Simulation<Dim>::stress_point_history(std::string_view name) const {
+  const int k = history_layout().find(name);
+  if (k < 0) throw SolverError(fmt::format("no material of this case has the history variable '{}'", name));
+  return HistoryView(stress_points().view(model_->fields.sp_history), history_layout(), stress_points().material, k);
+}
+
+template <int Dim>
+long Simulation<Dim>::max_source_substeps() const {
+  for (const auto& stage : scheme_->stages()) {
+    if (auto* s = dynamic_cast<const NodeFullStep<Dim>*>(stage.get())) return s->sources().max_substeps();
+  }
+  return 0;
+}
+
+template class Simulation<1>;
+template class Simulation<2>;
+template class Simulation<3>;
+
+}  // namespace rktsph

@@ -1,0 +1,103 @@
+#pragma once
+// A run of a case: the model (particles, operators, constraints), the scheme made for it by
+// name (schemes/registry.hpp) and the time control. step() is the algorithm of one time step
+// as written in method-notes §5: the scheme's stages in order, then the step's balance
+// (momentum, kinetic energy, a non-finite check), the energy account and the growth guard.
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+
+#include "case/case_setup.hpp"
+#include "materials/history_layout.hpp"
+#include "schemes/scheme.hpp"
+#include "schemes/staggered_model.hpp"
+#include "schemes/time_control.hpp"
+
+namespace rktsph {
+
+/// The value of one named history variable per particle (0 where the particle's material does
+/// not have it).
+class HistoryView {
+ public:
+  HistoryView(FieldView<const double, 0> values, const HistoryLayout& layout, const std::vector<int>& material, int name)
+      : values_(values), layout_(&layout), material_(&material), name_(name) {}
+  template <std::integral I>
+  double operator()(I i) const {
+    const int slot = layout_->slot((*material_)[static_cast<std::size_t>(i)], static_cast<std::size_t>(name_));
+    return slot < 0 ? 0.0 : values_(i, slot);
+  }
+
+ private:
+  FieldView<const double, 0> values_;
+  const HistoryLayout* layout_;
+  const std::vector<int>* material_;
+  int name_;
+};
+
+template <int Dim>
+class Simulation {
+ public:
+  /// Build the model and the scheme named by setup.version, and set the initial state.
+  explicit Simulation(CaseSetup<Dim> setup, exec::Threads policy = {});
+
+  /// Advance one time step t^n -> t^{n+1}. Throws SolverError if the state becomes non-finite
+  /// or grows without bound; the state of that step is then lost but earlier output is kept.
+  void step();
+
+  double time() const { return clock_.time(); }
+  double dt() const { return clock_.dt(); }
+  long step_count() const { return clock_.steps(); }
+  double cfl() const { return clock_.courant(); }
+  double max_wave_speed() const { return clock_.wave_speed(); }
+  const TimeControl<Dim>& clock() const { return clock_; }
+
+  const StaggeredModel<Dim>& model() const { return *model_; }
+  StaggeredModel<Dim>& model() { return *model_; }
+  const Scheme& scheme() const { return *scheme_; }
+  const CaseSetup<Dim>& setup() const { return model_->setup; }
+  const ParticleSet<Dim>& nodes() const { return model_->nodes; }
+  const ParticleSet<Dim>& stress_points() const { return model_->stress_points; }
+
+  // Typed views of the state (particles/field.hpp).
+  VectorView<Dim> node_velocity() const { return VectorView<Dim>(nodes().view(model_->fields.velocity)); }
+  StressView<Dim> node_stress() const { return StressView<Dim>(nodes().view(model_->fields.stress)); }
+  VectorView<Dim> node_displacement() const { return VectorView<Dim>(nodes().view(model_->fields.displacement)); }
+  VectorView<Dim> stress_point_velocity() const {
+    return VectorView<Dim>(stress_points().view(model_->fields.sp_velocity));
+  }
+  StressView<Dim> stress_point_stress() const { return StressView<Dim>(stress_points().view(model_->fields.sp_stress)); }
+  /// Node pore pressure, Pa (compression positive); empty in a dry scheme.
+  std::span<const double> node_pore_pressure() const;
+  bool saturated() const { return model_->fields.pore_pressure.valid(); }
+  const HistoryLayout& history_layout() const { return model_->materials.history; }
+  /// History variable `name` at the nodes (throws SolverError if no material declares it).
+  HistoryView node_history(std::string_view name) const;
+  HistoryView stress_point_history(std::string_view name) const;
+
+  // Writable state, for tests that seed a mode and watch it.
+  FieldView<double, Dim> mutable_node_velocity() { return model_->nodes.view(model_->fields.velocity); }
+  FieldView<double, kStressComponents<Dim>> mutable_node_stress() { return model_->nodes.view(model_->fields.stress); }
+  std::span<double> mutable_node_pore_pressure();
+
+  /// Energies at the current time (the stored energy is summed here, so call it sparingly).
+  EnergyBalance energy() const;
+
+  /// Memory held by the state (particle sets and the stages' work space) and by the operators.
+  std::size_t state_bytes() const { return model_->state_bytes() + scheme_->scratch_bytes(); }
+  std::size_t operator_bytes() const { return model_->operator_bytes(); }
+  std::size_t pairs() const { return model_->pairs(); }
+  Index operator_patterns() const { return model_->to_stress_points.patterns() + model_->to_nodes.patterns(); }
+  Index degenerate_operator_rows() const { return model_->degenerate_operator_rows(); }
+  long max_source_substeps() const;
+
+ private:
+  StepSums<Dim> balance_sums();
+
+  std::unique_ptr<StaggeredModel<Dim>> model_;
+  std::unique_ptr<Scheme> scheme_;
+  TimeControl<Dim> clock_;
+  exec::ReductionScratch reduction_;
+};
+
+}  // namespace rktsph

@@ -1,0 +1,31 @@
+#pragma once
+// A stage: one named part of a time step, acting on the particle sets and operators of a model
+// (docs/architecture.md, "Schemes and stages"). A scheme is an ordered list of stages
+// (schemes/scheme.hpp); the stages of V1 are reused by V3 and by any scheme registered later.
+#include <cstddef>
+#include <string_view>
+
+namespace rktsph {
+
+/// What every stage of a step t^n -> t^{n+1} is told.
+struct StepContext {
+  double t = 0.0;        // t^n, s
+  double dt = 0.0;       // s
+  double damping = 0.0;  // velocity damping coefficient in force over the step, 1/s
+};
+
+class Stage {
+ public:
+  virtual ~Stage() = default;
+  Stage() = default;
+  Stage(const Stage&) = delete;
+  Stage& operator=(const Stage&) = delete;
+
+  /// A short name for logs and profiles, e.g. "stress_points_half_step".
+  virtual std::string_view name() const = 0;
+  virtual void run(const StepContext& context) = 0;
+  /// Bytes of work space the stage holds (counted with the state).
+  virtual std::size_t scratch_bytes() const { return 0; }
+};
+
+}  // namespace rktsph

@@ -1,0 +1,204 @@
+#include "schemes/staggered_model.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "core/error.hpp"
+
+namespace rktsph {
+
+namespace {
+
+template <int Dim>
+SourceRuns make_source_runs(const ParticleSet<Dim>& set, const MaterialTable& materials) {
+  SourceRuns runs;
+  constexpr Index kChunk = 512;
+  Index i = 0;
+  while (i < set.size()) {
+    const int m = set.material[static_cast<std::size_t>(i)];
+    Index j = i;
+    while (j < set.size() && set.material[static_cast<std::size_t>(j)] == m && j - i < kChunk) ++j;
+    if (materials[m].has_source()) runs.push_back({m, i, j});
+    i = j;
+  }
+  return runs;
+}
+
+std::vector<std::string> axis_names(const char* prefix, int dim) {
+  std::vector<std::string> out;
+  for (int d = 0; d < dim; ++d) out.push_back(fmt::format("{}{}", prefix, kAxisNames[static_cast<std::size_t>(d)]));
+  return out;
+}
+
+template <int Dim>
+std::vector<std::string> stress_names() {
+  std::vector<std::string> out(kStressComponents<Dim>);
+  for (std::size_t c = 0; c < 6; ++c) {
+    const int s = stress_slot<Dim>(static_cast<StressComponent>(c));
+    if (s >= 0) out[static_cast<std::size_t>(s)] = fmt::format("s{}", kStressComponentNames[c]);
+  }
+  return out;
+}
+
+}  // namespace
+
+template <int Dim>
+StaggeredModel<Dim>::StaggeredModel(CaseSetup<Dim> case_setup, exec::Threads threads)
+    : setup(std::move(case_setup)), policy(threads), kernel(setup.h_over_dx * setup.dx) {
+  materials.models = setup.materials;
+  std::vector<double> densities;
+  for (const auto& m : materials.models) {
+    densities.push_back(m->density());
+    materials.elastic.push_back(m->elastic_rate());
+    materials.any_source = materials.any_source || m->has_source();
+  }
+  materials.history = HistoryLayout(materials.models);
+
+  LatticeParticles<Dim> lat = generate_lattice<Dim>(setup.blocks, setup.dx, setup.origin, densities);
+  lattice = std::move(lat.lattice);
+  nodes = std::move(lat.nodes);
+  boundary = std::move(lat.boundary);
+  if (setup.layout == ParticleLayout::collocated) {
+    // Single-set comparison scheme: the half step lives on the nodes themselves.
+    stress_points = nodes;
+    stress_points.set_name("stress_points");
+  } else {
+    stress_points = std::move(lat.stress_points);
+  }
+
+  // Time step from the wave speed (method-notes §4.3 and §0.3 item 4).
+  time_step = time_step_from(setup.dx, max_wave_speed(materials.models), setup.cfl, setup.dt);
+  if (time_step.courant > kMaxCourant) {
+    throw InputError(fmt::format(
+        "{}, key 'time.{}': the Courant number c dt/dx = {:.3f} exceeds {} (c = {:.4g} m/s, "
+        "dx = {} m); the scheme is unstable beyond it (method-notes §0.3 item 4)",
+        setup.file, setup.dt ? "dt" : "cfl", time_step.courant, kMaxCourant, time_step.wave_speed, setup.dx));
+  }
+
+  // Operators, built once from relations that are then dropped: the particles do not move.
+  {
+    Relation<Dim> relation;
+    relation.build(stress_points.position, nodes.position, operator_relation_options(kernel), policy);
+    to_stress_points = build_corrected_operator<Dim>(relation, stress_points.position, nodes, kernel);
+    relation.build(nodes.position, stress_points.position, operator_relation_options(kernel), policy);
+    to_nodes = build_corrected_operator<Dim>(relation, nodes.position, stress_points, kernel);
+  }
+
+  // Fields.
+  const int history = materials.history.stride();
+  fields.velocity = nodes.template add_field<double, Dim>("velocity", axis_names("v", Dim), kFieldOutput | kFieldEvolving);
+  fields.stress = nodes.template add_field<double, NS>("stress", stress_names<Dim>(), kFieldOutput | kFieldEvolving);
+  fields.displacement =
+      nodes.template add_field<double, Dim>("displacement", axis_names("u", Dim), kFieldOutput | kFieldEvolving);
+  fields.history = nodes.template add_field<double, 0>("history", materials.history.names(),
+                                                       kFieldOutput | kFieldEvolving, history);
+  fields.sp_velocity =
+      stress_points.template add_field<double, Dim>("velocity", axis_names("v", Dim), kFieldOutput | kFieldEvolving);
+  fields.sp_stress =
+      stress_points.template add_field<double, NS>("stress", stress_names<Dim>(), kFieldOutput | kFieldEvolving);
+  fields.sp_history = stress_points.template add_field<double, 0>("history", materials.history.names(),
+                                                                  kFieldOutput | kFieldEvolving, history);
+
+  node_sources = make_source_runs(nodes, materials);
+  stress_point_sources = make_source_runs(stress_points, materials);
+
+  constraints.resolve(setup.boundaries, nodes, boundary, setup.dx);
+  std::vector<Vec<Dim>> constrained_positions;
+  for (const Index i : constraints.constrained()) constrained_positions.push_back(nodes.position[static_cast<std::size_t>(i)]);
+  Relation<Dim> relation;
+  relation.build(constrained_positions, stress_points.position, difference_gradient_relation_options(kernel), policy);
+  constrained_gradient = build_difference_gradient<Dim>(relation, constrained_positions, stress_points, kernel);
+}
+
+template <int Dim>
+void StaggeredModel<Dim>::set_pore_pressure(Field<double, 1> field) {
+  fields.pore_pressure = field;
+  pore_pressure_ = nodes.view(field).data();
+}
+
+template <int Dim>
+void StaggeredModel<Dim>::apply_constraints(double t) {
+  // Only the few constrained nodes, not the whole set: this runs two or three times a step.
+  auto v = nodes.view(fields.velocity);
+  auto s = nodes.view(fields.stress);
+  for (const Index i : constraints.constrained()) {
+    for (Index k = constraints.begin(i); k < constraints.end(i); ++k) {
+      const NodalConstraint& c = constraints[k];
+      const double value = constraint_value(i, c, t);  // V3: sigma' = sigma + p_w
+      if (c.component < Dim) {
+        v(i, c.component) = value;
+      } else {
+        s(i, c.component - Dim) = value;
+      }
+    }
+  }
+}
+
+template <int Dim>
+double StaggeredModel<Dim>::boundary_power() const {
+  // Power of the surface tractions: sum over face nodes of A (sigma . n) . v.
+  const auto v = nodes.view(fields.velocity);
+  const auto s = nodes.view(fields.stress);
+  double power = 0.0;
+  for (std::size_t b = 0; b < boundary.size(); ++b) {
+    const Index i = boundary.node[b];
+    const std::uint8_t faces = boundary.faces[b];
+    for (int d = 0; d < Dim; ++d) {
+      for (int side = 0; side < 2; ++side) {
+        if (((faces >> (2 * d + side)) & 1u) == 0) continue;
+        const double normal = side == 0 ? -1.0 : 1.0;
+        const double area = boundary.area[b][static_cast<std::size_t>(2 * d + side)];
+        for (int k = 0; k < Dim; ++k) {
+          // V3: the traction is the total stress sigma' - p_w 1.
+          const double sk = s(i, stress_slot<Dim>(k, d)) - (pore_pressure_ != nullptr && k == d ? pore_pressure_[i] : 0.0);
+          power += area * sk * normal * v(i, k);
+        }
+      }
+    }
+  }
+  return power;
+}
+
+template <int Dim>
+void StaggeredModel<Dim>::set_initial_state() {
+  const auto nn = nodes.size();
+  const int vertical = Dim - 1;  // the last axis points up
+  const double g = setup.gravity.norm();
+  double surface = -std::numeric_limits<double>::infinity();
+  for (const auto& x : nodes.position) surface = std::max(surface, x[vertical]);
+  if (setup.surface_level) surface = *setup.surface_level;
+  auto v = nodes.view(fields.velocity);
+  auto s = nodes.view(fields.stress);
+  auto k = nodes.view(fields.history);
+  for (Index i = 0; i < nn; ++i) {
+    const auto iu = static_cast<std::size_t>(i);
+    for (int d = 0; d < Dim; ++d) v(i, d) = setup.initial_velocity[d];
+    const int m = nodes.material[iu];
+    if (setup.initial_stress == InitialStressKind::geostatic) {
+      // method-notes §4.2 option A: sigma_v = -rho g (H - z), lateral = K0 sigma_v.
+      const double nu = materials[m].elastic().nu;
+      const double k0 = setup.k0.value_or(nu / (1.0 - nu));
+      const double sv = -nodes.density[iu] * g * (surface - nodes.position[iu][vertical]);
+      for (int n = 0; n < 3; ++n) s(i, n) = (n == vertical ? 1.0 : k0) * sv;
+    } else if (setup.initial_stress == InitialStressKind::uniform) {
+      from_sym6<Dim>(setup.uniform_stress, s[i]);
+    }
+    if (k.components() > 0) materials[m].initial_state(to_sym6<Dim>(s[i]), k[i]);
+  }
+  apply_constraints(0.0);
+}
+
+template <int Dim>
+std::size_t StaggeredModel<Dim>::operator_bytes() const {
+  return to_stress_points.bytes() + to_nodes.bytes() +
+         constrained_gradient.source.size() * (sizeof(Index) + sizeof(Vec<Dim>)) + constraints.bytes();
+}
+
+template class StaggeredModel<1>;
+template class StaggeredModel<2>;
+template class StaggeredModel<3>;
+
+}  // namespace rktsph

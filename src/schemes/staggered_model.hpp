@@ -1,0 +1,119 @@
+#pragma once
+// The shared room of the staggered schemes (V1 dry, V3 saturated; method-notes §3.3, §5.1,
+// §5.3): the two particle sets and their fields, the materials, the corrected operators
+// between the sets, the boundary constraints and the loads. Stages (schemes/stage.hpp) act on
+// it; a scheme is a list of them (schemes/scheme.hpp).
+//
+// Nodes carry the state at t^n (velocity, stress, displacement, history); stress points carry
+// the half-step state at t^{n+1/2} (velocity, stress, history). The particles do not move in
+// these schemes, so the operators are built once, from relations that are then released.
+#include <array>
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "bc/constraints.hpp"
+#include "case/case_setup.hpp"
+#include "core/execution.hpp"
+#include "core/kernel.hpp"
+#include "materials/history_layout.hpp"
+#include "operators/corrected_operator.hpp"
+#include "particles/lattice.hpp"
+#include "particles/particle_set.hpp"
+#include "schemes/time_step.hpp"
+
+namespace rktsph {
+
+/// Handles of the fields the staggered schemes register.
+template <int Dim>
+struct StaggeredFields {
+  static constexpr int NS = kStressComponents<Dim>;
+  // nodes, t^n
+  Field<double, Dim> velocity;      // m/s
+  Field<double, NS> stress;         // Pa (effective stress sigma' in V3)
+  Field<double, Dim> displacement;  // m
+  Field<double, 0> history;         // the materials' history variables (HistoryLayout)
+  Field<double, 1> pore_pressure;   // Pa, compression positive; valid only in saturated schemes
+  // stress points, t^{n+1/2}
+  Field<double, Dim> sp_velocity;
+  Field<double, NS> sp_stress;
+  Field<double, 0> sp_history;
+};
+
+/// The materials as the stages use them: the models, and per material the constants hoisted
+/// out of the loops.
+struct MaterialTable {
+  std::vector<std::shared_ptr<const Material>> models;
+  std::vector<ElasticRate> elastic;  // per material
+  HistoryLayout history;
+  bool any_source = false;
+  const Material& operator[](int m) const { return *models[static_cast<std::size_t>(m)]; }
+};
+
+/// Runs of consecutive particles of one material that has a source: (material, begin, end),
+/// cut into chunks for the threads.
+using SourceRuns = std::vector<std::array<Index, 3>>;
+
+template <int Dim>
+class StaggeredModel {
+ public:
+  static constexpr int NS = kStressComponents<Dim>;
+
+  /// Particles, materials, time step, operators and constraints of a case. Throws InputError
+  /// for a case the schemes cannot run (a Courant number above kMaxCourant).
+  explicit StaggeredModel(CaseSetup<Dim> setup, exec::Threads policy = {});
+
+  CaseSetup<Dim> setup;
+  exec::Threads policy;
+  CubicSplineKernel<Dim> kernel;
+  MaterialTable materials;
+  Lattice<Dim> lattice;
+  ParticleSet<Dim> nodes{"nodes"};
+  ParticleSet<Dim> stress_points{"stress_points"};
+  BoundaryNodes<Dim> boundary;
+  StaggeredFields<Dim> fields;
+  TimeStep time_step;
+
+  CorrectedOperator<Dim> to_stress_points;  // nodes -> stress points (step 1)
+  CorrectedOperator<Dim> to_nodes;          // stress points -> nodes (step 2, filter)
+  NodalConstraints<Dim> constraints;
+  /// Stress points -> constrained nodes, in the difference form (method-notes §0.3 item 1 fix (a)).
+  DifferenceGradient<Dim> constrained_gradient;
+  SourceRuns node_sources, stress_point_sources;
+
+  double dx() const { return setup.dx; }
+  double function_value(int f, double t) const { return setup.function_value(f, t); }
+  /// Body force per unit mass at time t, m/s^2.
+  Vec<Dim> body_force(double t) const { return function_value(setup.gravity_function, t) * setup.gravity; }
+
+  /// Value of a prescribed component at node i at time t. A prescribed normal stress is a
+  /// TOTAL stress: with a pore pressure the effective stress held is sigma + p_w.
+  double constraint_value(Index i, const NodalConstraint& c, double t) const {
+    double v = c.value * function_value(c.function, t);
+    if (pore_pressure_ != nullptr && c.component >= Dim && c.component < 2 * Dim) v += pore_pressure_[i];
+    return v;
+  }
+  /// Overwrite the prescribed components with their values at time t.
+  void apply_constraints(double t);
+  /// Power of the surface tractions on the body, W (per unit thickness in 2D): the sum over
+  /// face nodes of A (sigma . n) . v, with the total stress.
+  double boundary_power() const;
+
+  /// Initial velocity, stress and history (method-notes §4.2), then the constraints at t = 0.
+  void set_initial_state();
+
+  /// A saturated scheme registers the node pore pressure here: constraints and the traction
+  /// power then use the total stress sigma' - p_w 1.
+  void set_pore_pressure(Field<double, 1> field);
+
+  /// Memory of the particle state and of the operators, bytes.
+  std::size_t state_bytes() const { return nodes.bytes() + stress_points.bytes(); }
+  std::size_t operator_bytes() const;
+  std::size_t pairs() const { return to_stress_points.pairs() + to_nodes.pairs(); }
+  Index degenerate_operator_rows() const { return to_stress_points.degenerate_rows + to_nodes.degenerate_rows; }
+
+ private:
+  const double* pore_pressure_ = nullptr;
+};
+
+}  // namespace rktsph

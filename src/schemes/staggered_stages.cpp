@@ -1,0 +1,358 @@
+#include "schemes/staggered_stages.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <utility>
+
+#include "operators/run_sums.hpp"
+
+namespace rktsph {
+
+namespace {
+
+// Velocity after tau of dv/dt = a - c_d v with the acceleration a = (1/rho) div sigma + b frozen
+// over the step, integrated exactly (method-notes §4.2). The flux and the body force are damped
+// together: a state in equilibrium (a = 0, v = 0) stays at rest whatever c_d tau. Damping only
+// the source b and adding the flux undamped left the discrete equilibrium with div sigma =
+// -rho b (1 - e^{-c_d tau})/(c_d tau): 2.4 % of the weight unsupported in Case 4(a), c_d tau = 0.05.
+inline double damped_velocity(double v0, double a, double cd, double tau) {
+  if (cd == 0.0) return v0 + a * tau;
+  const double decay = -std::expm1(-cd * tau);  // 1 - e^{-c_d tau}
+  return v0 - decay * v0 + a * decay / cd;
+}
+
+// The balance of momentum (method-notes eq. (1.2.1)): dv_i/dt = (1/rho) d sigma_ij / dx_j, from
+// grad_s[d][s], the derivative along axis d of stress slot s.
+template <int Dim>
+inline void momentum_rate(const double (&grad_s)[Dim][kStressComponents<Dim>], double inv_rho, double* dv) {
+  for (int i = 0; i < Dim; ++i) {
+    double div = 0.0;
+    for (int d = 0; d < Dim; ++d) div += grad_s[d][stress_slot<Dim>(i, d)];
+    dv[i] = div * inv_rho;
+  }
+}
+
+}  // namespace
+
+// ---- sources
+
+template <int Dim>
+ViscoplasticSources<Dim>::ViscoplasticSources(StaggeredModel<Dim>& model) : model_(model) {
+  if (model.materials.any_source) {
+    const auto n = static_cast<std::size_t>(std::max(model.nodes.size(), model.stress_points.size()));
+    sigma_start_.assign(n * NS, 0.0);
+    rate_.assign(n * NS, 0.0);
+  }
+}
+
+template <int Dim>
+void ViscoplasticSources<Dim>::integrate(double tau, const SourceRuns& runs, FieldView<double, NS> stress,
+                                         FieldView<double, 0> history) {
+  const auto stride = static_cast<std::size_t>(history.components());
+  if (run_substeps_.size() < runs.size()) run_substeps_.resize(runs.size());  // grows once per run list
+  // Per run (not per particle): the runs are few and of uneven cost (sub-stepping), so threads
+  // pay off from a handful of runs on.
+  exec::particle_for(
+      exec::Threads{4}, static_cast<Index>(runs.size()),
+      [&](Index r) {
+        const auto [m, begin, end] = runs[static_cast<std::size_t>(r)];
+        SourceBatch batch;
+        batch.count = static_cast<std::size_t>(end - begin);
+        batch.stress_components = NS;
+        batch.sigma_start = sigma_start(begin);
+        batch.sigma_start_stride = NS;
+        batch.flux_rate = flux_rate(begin);
+        batch.flux_rate_stride = NS;
+        batch.sigma_end = stress[begin];
+        batch.sigma_end_stride = NS;
+        batch.state_start = history[begin];
+        batch.state_end = history[begin];
+        batch.state_stride = stride;
+        batch.coupling = model_.setup.coupling;
+        run_substeps_[static_cast<std::size_t>(r)] = model_.materials[m].advance_source(tau, batch).max_substeps;
+      },
+      exec::Schedule::dynamic);
+  for (std::size_t r = 0; r < runs.size(); ++r) max_substeps_ = std::max(max_substeps_, run_substeps_[r]);
+}
+
+// ---- step 1
+
+template <int Dim, class PressureTerm>
+StressPointHalfStep<Dim, PressureTerm>::StressPointHalfStep(StaggeredModel<Dim>& model,
+                                                            std::shared_ptr<ViscoplasticSources<Dim>> sources,
+                                                            PressureTerm pressure)
+    : m_(model), sources_(std::move(sources)), pressure_(pressure) {}
+
+template <int Dim, class PressureTerm>
+void StressPointHalfStep<Dim, PressureTerm>::run(const StepContext& c) {
+  constexpr int NS = kStressComponents<Dim>;
+  const double tau = 0.5 * c.dt;
+  const Vec<Dim> body = m_.body_force(c.t + 0.5 * tau);
+  double b[Dim];
+  for (int d = 0; d < Dim; ++d) b[d] = body[d];
+  const double cd = c.damping;
+  const CorrectedOperator<Dim>& op = m_.to_stress_points;
+  const ParticleSet<Dim>& sp = m_.stress_points;
+  // Shared row patterns (operators/corrected_operator.hpp): pair k of stress point e has the
+  // source base[e] + off[k]; on a lattice the few patterns' weights stay in the L1 cache.
+  const Index* base = op.base.data();
+  const Index* pat = op.pattern.data();
+  const Index* pstart = op.pattern_start.data();
+  const Index* off = op.offset.data();
+  const double* wi = op.interp.data();
+  const auto* wg = op.grad.data();
+  const auto node_v = std::as_const(m_.nodes).view(m_.fields.velocity);
+  const auto node_s = std::as_const(m_.nodes).view(m_.fields.stress);
+  const auto node_k = std::as_const(m_.nodes).view(m_.fields.history);
+  auto sp_v = m_.stress_points.view(m_.fields.sp_velocity);
+  auto sp_s = m_.stress_points.view(m_.fields.sp_stress);
+  auto sp_k = m_.stress_points.view(m_.fields.sp_history);
+  const int stride = sp_k.components();
+  const bool sources = sources_->active();
+  ViscoplasticSources<Dim>& src = *sources_;
+  const PressureTerm& pressure = pressure_;
+  exec::particle_for(
+      m_.policy, op.runs(),
+      [&](Index r) {
+        // Interpolated state (slot 0) and its gradient (slots 1..Dim) of the run's stress points.
+        double acc_v[Dim + 1][CorrectedOperator<Dim>::kMaxRun * Dim];
+        double acc_s[Dim + 1][CorrectedOperator<Dim>::kMaxRun * NS];
+        const Index e0 = op.run_start[static_cast<std::size_t>(r)], e1 = op.run_start[static_cast<std::size_t>(r) + 1];
+        const Index k0 = pstart[pat[e0]], k1 = pstart[pat[e0] + 1];
+        interpolate_run<Dim, Dim>(op, node_v.data(), r, acc_v);
+        interpolate_run<Dim, NS>(op, node_s.data(), r, acc_s);
+        for (Index e = e0; e < e1; ++e) {
+          const auto sv = static_cast<std::size_t>(e - e0) * Dim;
+          const auto ss = static_cast<std::size_t>(e - e0) * NS;
+          double bar_v[Dim], bar_s[NS];
+          double grad_v[Dim][Dim], grad_s[Dim][NS];
+          for (int k = 0; k < Dim; ++k) {
+            bar_v[k] = acc_v[0][sv + static_cast<std::size_t>(k)];
+            for (int d = 0; d < Dim; ++d) grad_v[d][k] = acc_v[1 + d][sv + static_cast<std::size_t>(k)];
+          }
+          for (int s = 0; s < NS; ++s) {
+            bar_s[s] = acc_s[0][ss + static_cast<std::size_t>(s)];
+            for (int d = 0; d < Dim; ++d) grad_s[d][s] = acc_s[1 + d][ss + static_cast<std::size_t>(s)];
+          }
+          const auto eu = static_cast<std::size_t>(e);
+          const int mat = sp.material[eu];
+          double dv[Dim], dsig[NS];
+          momentum_rate<Dim>(grad_s, 1.0 / sp.density[eu], dv);
+          m_.materials.elastic[static_cast<std::size_t>(mat)](grad_v, dsig);
+          if constexpr (PressureTerm::kActive) {
+            // V3 (method-notes §5.3): -grad p^n / rho in the stress points' half step.
+            if (pressure.skeleton.data() != nullptr) {
+              for (int i = 0; i < Dim; ++i) pressure.skeleton(e, i) = damped_velocity(bar_v[i], dv[i] + b[i], cd, tau);
+            }
+            for (Index k = k0; k < k1; ++k) {
+              const double pr = pressure.pressure[static_cast<std::size_t>(base[e] + off[k])] / sp.density[eu];
+              for (int d = 0; d < Dim; ++d) dv[d] -= wg[k][static_cast<std::size_t>(d)] * pr;
+            }
+          }
+          for (int i = 0; i < Dim; ++i) sp_v(e, i) = damped_velocity(bar_v[i], dv[i] + b[i], cd, tau);
+          for (int s = 0; s < NS; ++s) sp_s(e, s) = bar_s[s] + tau * dsig[s];
+          if (sources) {
+            double* start = src.sigma_start(e);
+            double* rate = src.flux_rate(e);
+            for (int s = 0; s < NS; ++s) {
+              start[s] = bar_s[s];
+              rate[s] = dsig[s];
+            }
+          }
+          if (stride > 0) {
+            // History variables are interpolated from the nodes (method-notes §3.3: nodes are
+            // primary).
+            double* ks = sp_k[e];
+            for (int j = 0; j < stride; ++j) ks[j] = 0.0;
+            for (Index k = k0; k < k1; ++k) {
+              const double* kn = node_k[base[e] + off[k]];
+              for (int j = 0; j < stride; ++j) ks[j] += wi[k] * kn[j];
+            }
+          }
+        }
+      },
+      exec::Schedule::even, sp.size());
+  if (sources) src.integrate(tau, m_.stress_point_sources, sp_s, sp_k);
+}
+
+// ---- step 2
+
+template <int Dim>
+NodeFullStep<Dim>::NodeFullStep(StaggeredModel<Dim>& model, std::shared_ptr<ViscoplasticSources<Dim>> sources)
+    : m_(model), sources_(std::move(sources)) {}
+
+template <int Dim>
+void NodeFullStep<Dim>::run(const StepContext& c) {
+  constexpr int NS = kStressComponents<Dim>;
+  const double dt = c.dt;
+  const Vec<Dim> body = m_.body_force(c.t + 0.5 * dt);
+  double b[Dim];
+  for (int d = 0; d < Dim; ++d) b[d] = body[d];
+  const double cd = c.damping;
+  const double t_half = c.t + 0.5 * dt;
+  const CorrectedOperator<Dim>& op = m_.to_nodes;
+  const ParticleSet<Dim>& nodes = m_.nodes;
+  const auto sp_v = std::as_const(m_.stress_points).view(m_.fields.sp_velocity);
+  const auto sp_s = std::as_const(m_.stress_points).view(m_.fields.sp_stress);
+  auto node_v = m_.nodes.view(m_.fields.velocity);
+  auto node_s = m_.nodes.view(m_.fields.stress);
+  auto node_u = m_.nodes.view(m_.fields.displacement);
+  const NodalConstraints<Dim>& constraints = m_.constraints;
+  const DifferenceGradient<Dim>& diff = m_.constrained_gradient;
+  const bool sources = sources_->active();
+  ViscoplasticSources<Dim>& src = *sources_;
+  exec::particle_for(
+      m_.policy, op.runs(),
+      [&](Index r) {
+        // Interpolation (slot 0: the velocity for the displacement) and gradient of the stress
+        // points' state at the run's nodes.
+        double acc_v[Dim + 1][CorrectedOperator<Dim>::kMaxRun * Dim];
+        double acc_s[Dim + 1][CorrectedOperator<Dim>::kMaxRun * NS];
+        const Index i0 = op.run_start[static_cast<std::size_t>(r)], i1 = op.run_start[static_cast<std::size_t>(r) + 1];
+        interpolate_run<Dim, Dim>(op, sp_v.data(), r, acc_v);
+        interpolate_run<Dim, NS>(op, sp_s.data(), r, acc_s);
+        for (Index i = i0; i < i1; ++i) {
+          const auto sv = static_cast<std::size_t>(i - i0) * Dim;
+          const auto ss = static_cast<std::size_t>(i - i0) * NS;
+          double grad_v[Dim][Dim], grad_s[Dim][NS];
+          for (int k = 0; k < Dim; ++k) {
+            for (int d = 0; d < Dim; ++d) grad_v[d][k] = acc_v[1 + d][sv + static_cast<std::size_t>(k)];
+          }
+          for (int s = 0; s < NS; ++s) {
+            for (int d = 0; d < Dim; ++d) grad_s[d][s] = acc_s[1 + d][ss + static_cast<std::size_t>(s)];
+          }
+          const auto iu = static_cast<std::size_t>(i);
+          // The material velocity at t^{n+1/2} for the displacement: the stress points' velocity,
+          // interpolated back. Not the nodal v, which in a steady state keeps an O(dt) component
+          // the stress points never see (it balances the filter against the residual nodal
+          // force: method-notes §0.3 item 8), and would make u drift.
+          double v_half[Dim];
+          for (int d = 0; d < Dim; ++d) v_half[d] = acc_v[0][sv + static_cast<std::size_t>(d)];
+          for (Index q = constraints.begin(i); q < constraints.end(i); ++q) {
+            const NodalConstraint& con = constraints[q];
+            if (con.component < Dim) v_half[con.component] = m_.constraint_value(i, con, t_half);
+          }
+          const Index drow = constraints.constrained_row(i);
+          if (drow >= 0) {
+            // method-notes §0.3 fix (a): a prescribed component enters its own gradient through
+            // the difference form with fhat = the prescribed value at t^{n+1/2}.
+            const auto dr = static_cast<std::size_t>(drow);
+            for (Index q = constraints.begin(i); q < constraints.end(i); ++q) {
+              const NodalConstraint& con = constraints[q];
+              const double fhat = m_.constraint_value(i, con, t_half);
+              const bool is_velocity = con.component < Dim;
+              const int comp = is_velocity ? con.component : con.component - Dim;
+              double g[Dim] = {};
+              for (Index k = diff.row_start[dr]; k < diff.row_start[dr + 1]; ++k) {
+                const Index e = diff.source[static_cast<std::size_t>(k)];
+                const double f = is_velocity ? sp_v(e, comp) : sp_s(e, comp);
+                for (int d = 0; d < Dim; ++d) g[d] += diff.weight[static_cast<std::size_t>(k)][d] * f;
+              }
+              for (int d = 0; d < Dim; ++d) {
+                const double value = g[d] - diff.weight_sum[dr][d] * fhat;
+                if (is_velocity) {
+                  grad_v[d][comp] = value;
+                } else {
+                  grad_s[d][comp] = value;
+                }
+              }
+            }
+          }
+          const int mat = nodes.material[iu];
+          double dv[Dim], dsig[NS];
+          momentum_rate<Dim>(grad_s, 1.0 / nodes.density[iu], dv);
+          m_.materials.elastic[static_cast<std::size_t>(mat)](grad_v, dsig);
+          double* v = node_v[i];
+          double* s = node_s[i];
+          for (int d = 0; d < Dim; ++d) v[d] = damped_velocity(v[d], dv[d] + b[d], cd, dt);
+          if (sources) {
+            double* start = src.sigma_start(i);
+            double* rate = src.flux_rate(i);
+            for (int k = 0; k < NS; ++k) {
+              start[k] = s[k];
+              rate[k] = dsig[k];
+            }
+          }
+          for (int k = 0; k < NS; ++k) s[k] += dt * dsig[k];
+          // Displacement by the midpoint rule (method-notes §0.3 item 8).
+          for (int d = 0; d < Dim; ++d) node_u(i, d) += dt * v_half[d];
+        }
+      },
+      exec::Schedule::even, nodes.size());
+  if (sources) src.integrate(dt, m_.node_sources, node_s, m_.nodes.view(m_.fields.history));
+}
+
+// ---- velocity filter
+
+template <int Dim>
+VelocityFilter<Dim>::VelocityFilter(StaggeredModel<Dim>& model, double strength)
+    : m_(model),
+      strength_(strength),
+      at_stress_points_(static_cast<std::size_t>(model.stress_points.size()) * Dim, 0.0),
+      at_nodes_(static_cast<std::size_t>(model.nodes.size()) * Dim, 0.0) {}
+
+template <int Dim>
+void VelocityFilter<Dim>::run(const StepContext&) {
+  const Index ne = m_.stress_points.size();
+  const Index nn = m_.nodes.size();
+  const double eps = strength_;
+  const CorrectedOperator<Dim>& en = m_.to_stress_points;
+  const CorrectedOperator<Dim>& ne_op = m_.to_nodes;
+  FieldView<double, Dim> filter_sp(at_stress_points_.data(), ne, Dim);
+  FieldView<double, Dim> filter_node(at_nodes_.data(), nn, Dim);
+  auto v = m_.nodes.view(m_.fields.velocity);
+  auto to_stress_points = [&](const double* node_field) {
+    // By runs (run_sums): the vector loop over a run's contiguous sources.
+    exec::particle_for(
+        m_.policy, en.runs(),
+        [&](Index r) {
+          double acc[CorrectedOperator<Dim>::kMaxRun * Dim];
+          double* sums[1] = {acc};
+          const Index e0 = en.run_start[static_cast<std::size_t>(r)], e1 = en.run_start[static_cast<std::size_t>(r) + 1];
+          const auto e0u = static_cast<std::size_t>(e0);
+          const auto p = static_cast<std::size_t>(en.pattern[e0u]);
+          run_sums<1, 16>(node_field + static_cast<std::size_t>(en.base[e0u]) * Dim, Dim,
+                          static_cast<std::size_t>(e1 - e0) * Dim, en.offset.data(), en.pattern_start[p],
+                          en.pattern_start[p + 1],
+                          [&](Index k, double* w) { w[0] = en.interp[static_cast<std::size_t>(k)]; }, sums);
+          for (Index e = e0; e < e1; ++e) {
+            for (int d = 0; d < Dim; ++d) filter_sp(e, d) = acc[static_cast<std::size_t>(e - e0) * Dim + static_cast<std::size_t>(d)];
+          }
+        },
+        exec::Schedule::even, ne);
+  };
+  auto back_to_nodes = [&](Index i, double* acc) {
+    for (int d = 0; d < Dim; ++d) acc[d] = 0.0;
+    const auto row = ne_op.row(i);
+    for (Index k = row.begin; k < row.end; ++k) {
+      const double wk = ne_op.interp[static_cast<std::size_t>(k)];
+      const double* p = filter_sp[ne_op.source(row, k)];
+      for (int d = 0; d < Dim; ++d) acc[d] += wk * p[d];
+    }
+  };
+  to_stress_points(v.data());
+  exec::particle_for(m_.policy, nn, [&](Index i) {
+    double acc[Dim];
+    back_to_nodes(i, acc);
+    for (int d = 0; d < Dim; ++d) filter_node(i, d) = v(i, d) - acc[d];
+  });
+  to_stress_points(filter_node.data());
+  exec::particle_for(m_.policy, nn, [&](Index i) {
+    double acc[Dim];
+    back_to_nodes(i, acc);
+    for (int d = 0; d < Dim; ++d) v(i, d) -= eps * (filter_node(i, d) - acc[d]);
+  });
+}
+
+#define RKTSPH_INSTANTIATE(D)                                        \
+  template class ViscoplasticSources<D>;                            \
+  template class StressPointHalfStep<D, NoPressureGradient>;        \
+  template class StressPointHalfStep<D, PorePressureGradient<D>>;   \
+  template class NodeFullStep<D>;                                   \
+  template class VelocityFilter<D>;
+RKTSPH_INSTANTIATE(1)
+RKTSPH_INSTANTIATE(2)
+RKTSPH_INSTANTIATE(3)
+#undef RKTSPH_INSTANTIATE
+
+}  // namespace rktsph

@@ -1,0 +1,122 @@
+#pragma once
+// The stages of the staggered RKT-SPH step (method-notes §5.1, §2.2, §0.3):
+//   StressPointHalfStep  step 1: nodes -> stress points, t^n -> t^{n+1/2}
+//   NodeFullStep         step 2: stress points -> nodes, t^n -> t^{n+1}, and the displacement
+//   ApplyConstraints     prescribed components at t^{n+1}
+//   VelocityFilter       the fourth-order velocity filter (method-notes §0.3 item 3)
+// Viscoplastic sources are integrated by Runge–Kutta inside steps 1 and 2 (ViscoplasticSources).
+// The time loop allocates nothing: every work array is sized when a stage is made.
+#include <memory>
+#include <string_view>
+#include <vector>
+
+#include "schemes/stage.hpp"
+#include "schemes/staggered_model.hpp"
+
+namespace rktsph {
+
+/// Runge–Kutta integration of the materials' viscoplastic source over an interval (method-notes
+/// §2.2), shared by steps 1 and 2: each step records the start stress and the flux rate of its
+/// particles here, then integrates.
+template <int Dim>
+class ViscoplasticSources {
+ public:
+  static constexpr int NS = kStressComponents<Dim>;
+  explicit ViscoplasticSources(StaggeredModel<Dim>& model);
+
+  bool active() const { return model_.materials.any_source; }
+  /// Row of particle i: its start stress and its flux stress rate (NS values each).
+  double* sigma_start(Index i) { return FieldView<double, NS>(sigma_start_.data(), 0, NS)[i]; }
+  double* flux_rate(Index i) { return FieldView<double, NS>(rate_.data(), 0, NS)[i]; }
+  /// Advance the source of every particle of `runs` over tau: the stress field ends at the
+  /// source-corrected value, the history at its new value (method-notes §2.2, additive or
+  /// frozen-flux coupling).
+  void integrate(double tau, const SourceRuns& runs, FieldView<double, NS> stress, FieldView<double, 0> history);
+  /// The largest number of RK4 sub-steps one particle needed in one interval so far.
+  long max_substeps() const { return max_substeps_; }
+  std::size_t bytes() const { return (sigma_start_.size() + rate_.size()) * sizeof(double); }
+
+ private:
+  StaggeredModel<Dim>& model_;
+  std::vector<double> sigma_start_, rate_;
+  std::vector<long> run_substeps_;
+  long max_substeps_ = 0;
+};
+
+/// The pressure term of step 1 in a dry scheme: none.
+struct NoPressureGradient {
+  static constexpr bool kActive = false;
+};
+
+/// V3 (method-notes §5.3): -grad p^n / rho joins the stress points' half-step acceleration; with
+/// `skeleton` set, the pressure-free half-step velocity is kept per stress point as well (the
+/// option solver.pressure_divergence = "stress_points").
+template <int Dim>
+struct PorePressureGradient {
+  static constexpr bool kActive = true;
+  const double* pressure = nullptr;    // node p_w, Pa
+  FieldView<double, Dim> skeleton;      // stress points; empty when not kept
+};
+
+/// Step 1: interpolation and gradient of the nodal state at the stress points, half step of
+/// the flux and the sources (method-notes §5.1 step 1).
+template <int Dim, class PressureTerm = NoPressureGradient>
+class StressPointHalfStep final : public Stage {
+ public:
+  StressPointHalfStep(StaggeredModel<Dim>& model, std::shared_ptr<ViscoplasticSources<Dim>> sources,
+                      PressureTerm pressure = {});
+  std::string_view name() const override { return "stress_points_half_step"; }
+  void run(const StepContext& context) override;
+
+ private:
+  StaggeredModel<Dim>& m_;
+  std::shared_ptr<ViscoplasticSources<Dim>> sources_;
+  PressureTerm pressure_;
+};
+
+/// Step 2: gradient of the stress points' state at the nodes, full step of the flux and the
+/// sources; the displacement from the stress points' velocity (method-notes §5.1 step 2, §0.3
+/// item 8).
+template <int Dim>
+class NodeFullStep final : public Stage {
+ public:
+  NodeFullStep(StaggeredModel<Dim>& model, std::shared_ptr<ViscoplasticSources<Dim>> sources);
+  std::string_view name() const override { return "nodes_full_step"; }
+  void run(const StepContext& context) override;
+  const ViscoplasticSources<Dim>& sources() const { return *sources_; }
+  std::size_t scratch_bytes() const override { return sources_->bytes(); }
+
+ private:
+  StaggeredModel<Dim>& m_;
+  std::shared_ptr<ViscoplasticSources<Dim>> sources_;
+};
+
+/// The prescribed components at t^{n+1} (method-notes §4.1).
+template <int Dim>
+class ApplyConstraints final : public Stage {
+ public:
+  explicit ApplyConstraints(StaggeredModel<Dim>& model) : m_(model) {}
+  std::string_view name() const override { return "constraints"; }
+  void run(const StepContext& context) override { m_.apply_constraints(context.t + context.dt); }
+
+ private:
+  StaggeredModel<Dim>& m_;
+};
+
+/// v <- v - eps (I - P_NE P_EN)^2 v (method-notes §0.3 item 3): removes the nodal checkerboard
+/// that the stress points cannot see; exact on linear fields.
+template <int Dim>
+class VelocityFilter final : public Stage {
+ public:
+  VelocityFilter(StaggeredModel<Dim>& model, double strength);
+  std::string_view name() const override { return "velocity_filter"; }
+  void run(const StepContext& context) override;
+  std::size_t scratch_bytes() const override { return (at_stress_points_.size() + at_nodes_.size()) * sizeof(double); }
+
+ private:
+  StaggeredModel<Dim>& m_;
+  double strength_;
+  std::vector<double> at_stress_points_, at_nodes_;  // Dim values per particle
+};
+
+}  // namespace rktsph

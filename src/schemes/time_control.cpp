@@ -1,0 +1,66 @@
+#include "schemes/time_control.hpp"
+
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "core/error.hpp"
+
+namespace rktsph {
+
+template <int Dim>
+void TimeControl<Dim>::start(double initial_strain, double boundary_power, const StepSums<Dim>& sums) {
+  initial_strain_ = initial_strain;
+  last_power_ = boundary_power;
+  const double fb = setup_.function_value(setup_.gravity_function, 0.0);
+  for (int d = 0; d < Dim; ++d) last_power_ += fb * setup_.gravity[d] * sums[static_cast<std::size_t>(d)];
+  last_damping_power_ = damping_at(0.0) * sums[Dim];
+  kinetic_peak_ = 0.5 * sums[Dim];
+}
+
+template <int Dim>
+void TimeControl<Dim>::end_step(const StepSums<Dim>& sums, double boundary_power, const std::string& hint) {
+  const double dt = step_.dt;
+  const double t_new = time_ + dt;
+  const double fb = setup_.function_value(setup_.gravity_function, t_new);
+  double power = boundary_power;
+  for (int d = 0; d < Dim; ++d) power += fb * setup_.gravity[d] * sums[static_cast<std::size_t>(d)];
+  // Damping switched off once the kinetic energy has decayed (method-notes §4.2 option B).
+  const double kinetic = 0.5 * sums[Dim];
+  kinetic_peak_ = std::max(kinetic_peak_, kinetic);
+  // It must stay below the ratio for damping.kinetic_ratio_hold (an oscillation trough alone,
+  // with the energy momentarily in strain, must not end the relaxation).
+  if (setup_.damping_until_kinetic_ratio > 0.0 && t_new >= setup_.damping_ratio_from && t_new < damping_off_time_) {
+    if (kinetic < setup_.damping_until_kinetic_ratio * kinetic_peak_) {
+      if (kinetic_below_since_ < 0.0) kinetic_below_since_ = t_new;
+      if (t_new - kinetic_below_since_ >= setup_.damping_ratio_hold) damping_off_time_ = t_new;
+    } else {
+      kinetic_below_since_ = -1.0;
+    }
+  }
+  const double cd = damping_at(t_new);
+  const double damping_power = cd * sums[Dim];
+  external_work_ += 0.5 * dt * (last_power_ + power);
+  damping_loss_ += 0.5 * dt * (last_damping_power_ + damping_power);
+  // Growth guard: an unstable mode grows v^2 faster than the boundary power (~ v) feeds the
+  // work, so it trips this long before the values overflow; the factor leaves room for the
+  // scheme's own energy error.
+  const double budget = std::abs(external_work_) + initial_energy_;
+  if (kinetic > kEnergyGrowthLimit * budget && steps_ > 0) {
+    throw SolverError(fmt::format(
+        "the kinetic energy ({:.3g} J) exceeds {:g} times the work done on the body plus its initial energy "
+        "({:.3g} J) at step {} (t = {:.6g} s): the run is unstable; reduce the time step (time.cfl = {:.3g}) or check "
+        "the loads, the boundary conditions and the solver options{}",
+        kinetic, kEnergyGrowthLimit, budget, steps_ + 1, t_new, step_.courant, hint));
+  }
+  last_power_ = power;
+  last_damping_power_ = damping_power;
+  time_ = t_new;
+  ++steps_;
+}
+
+template class TimeControl<1>;
+template class TimeControl<2>;
+template class TimeControl<3>;
+
+}  // namespace rktsph

@@ -1,0 +1,48 @@
+// V3: the saturated v-p_w scheme in small deformation (method-notes §5.3): V1's stages with the
+// pore-pressure gradient in the stress points' half step, and the pressure stage after step 2:
+//   1. stress points: half step with -grad p^n / rho
+//   2. nodes: v*, sigma' (effective stress), displacement
+//   3. prescribed components (total stresses: sigma' = sigma + p_w)
+//   4. pressure: the storage equation by PCG, v^{n+1} = v* - (dt/rho) grad p^{n+1}
+//   5. prescribed components; the velocity filter and the prescribed components again.
+#include <memory>
+
+#include "schemes/pressure_stage.hpp"
+#include "schemes/registry.hpp"
+#include "schemes/staggered_stages.hpp"
+
+namespace rktsph {
+
+template <int Dim>
+std::unique_ptr<Scheme> make_v3_scheme(StaggeredModel<Dim>& model) {
+  auto scheme = std::make_unique<Scheme>("v3");
+  auto pressure = std::make_unique<PorePressureStage<Dim>>(model);
+  PorePressureGradient<Dim> gradient;
+  gradient.pressure = model.nodes.view(pressure->pore_pressure()).data();
+  gradient.skeleton = pressure->skeleton_velocity();
+  auto sources = std::make_shared<ViscoplasticSources<Dim>>(model);
+  scheme->add(std::make_unique<StressPointHalfStep<Dim, PorePressureGradient<Dim>>>(model, sources, gradient));
+  scheme->add(std::make_unique<NodeFullStep<Dim>>(model, sources));
+  scheme->add(std::make_unique<ApplyConstraints<Dim>>(model));
+  PorePressureStage<Dim>& stage = scheme->add(std::move(pressure));
+  scheme->add(std::make_unique<ApplyConstraints<Dim>>(model));
+  if (model.setup.filter) {
+    scheme->add(std::make_unique<VelocityFilter<Dim>>(model, model.setup.filter_strength));
+    scheme->add(std::make_unique<ApplyConstraints<Dim>>(model));
+  }
+  // The fluid's stored energy p^2/(2 Q*) per unit volume joins the energy account, and the
+  // growth guard names the undrained Courant limit when it applies.
+  const double inv_storage = stage.inverse_storage();
+  const double* pw = model.nodes.view(stage.pore_pressure()).data();
+  scheme->stored_energy_density = [inv_storage, pw](Index i) {
+    return inv_storage * pw[static_cast<std::size_t>(i)] * pw[static_cast<std::size_t>(i)];
+  };
+  scheme->instability_hint = [&stage] { return stage.instability_hint(); };
+  return scheme;
+}
+
+template std::unique_ptr<Scheme> make_v3_scheme<1>(StaggeredModel<1>&);
+template std::unique_ptr<Scheme> make_v3_scheme<2>(StaggeredModel<2>&);
+template std::unique_ptr<Scheme> make_v3_scheme<3>(StaggeredModel<3>&);
+
+}  // namespace rktsph
