@@ -7,14 +7,12 @@
 
 #include <chrono>
 #include <cstdio>
-#include <filesystem>
-#include <fstream>
 #include <string>
 #include <vector>
 
 #include <fmt/format.h>
 
-#include "case/case_reader.hpp"
+#include "case/case_builder.hpp"
 #include "operators/corrected_operator.hpp"
 #include "linear_solvers/pore_pressure.hpp"
 #include "schemes/pressure_stage.hpp"
@@ -44,40 +42,29 @@ void BM_Triad(benchmark::State& state) {
 }
 BENCHMARK(BM_Triad)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-// A square 2D elastic block with about `nodes` nodes, fixed base, loaded top. `top_extra` and
-// `tables` add keys to the top boundary and tables before [time] (the V3 variant).
-std::string block_case(long nodes, const std::string& top_extra = "", const std::string& tables = "", double cfl = 0.9) {
+// A square 2D elastic block with about `nodes` nodes, fixed base, loaded top (a case built in
+// code, case/case_builder.hpp). `v3`: saturated, drained top, K_f = 0.1 GPa, with the pressure
+// filter coefficient `filter`.
+CaseSetup<2> block_case(long nodes, bool v3 = false, double filter = 0.5, double cfl = 0.9) {
   const long side = static_cast<long>(std::lround(std::sqrt(static_cast<double>(nodes)))) - 1;
   const double dx = 0.1, length = static_cast<double>(side) * dx;
-  const std::string path = (std::filesystem::temp_directory_path() /
-                            fmt::format("rktsph_bench_{}{}.toml", nodes, tables.empty() ? "" : "_v3"))
-                               .string();
-  std::ofstream(path) << fmt::format(R"(
-[geometry]
-dimension = 2
-spacing = {dx}
-[[geometry.block]]
-min = [0.0, 0.0]
-max = [{L}, {L}]
-[material]
-model = "elastic"
-E = 2.0e7
-nu = 0.3
-density = 2000.0
-[[boundary]]
-y = [0.0, 0.0]
-velocity = {{ x = 0.0, y = 0.0 }}
-[[boundary]]
-y = [{L}, {L}]
-stress = {{ yy = -1.0e4 }}
-{top}
-{tables}
-[time]
-end = 1.0
-cfl = {cfl}
-)", fmt::arg("dx", dx), fmt::arg("L", length), fmt::arg("top", top_extra), fmt::arg("tables", tables),
-                                     fmt::arg("cfl", cfl));
-  return path;
+  CaseBuilder<2> b(fmt::format("benchmark block, {} nodes{}", nodes, v3 ? ", V3" : ""));
+  b.spacing(dx)
+      .block(Vec<2>(0.0, 0.0), Vec<2>(length, length))
+      .elastic(2.0e7, 0.3, 2000.0)
+      .fix_velocity(Region<2>::plane(1, 0.0), {0, 1})
+      .prescribe_stress(Region<2>::plane(1, length), StressComponent::yy, -1.0e4)
+      .time(1.0, cfl);
+  if (v3) {
+    FluidSpec fluid;
+    fluid.porosity = 0.3;
+    fluid.density = 1000.0;
+    fluid.bulk_modulus = 1.0e8;
+    fluid.conductivity = 1.0e-6;
+    fluid.filter = filter;
+    b.scheme("v3").fluid(fluid).drained(Region<2>::plane(1, length), 0.0);
+  }
+  return b.build();
 }
 
 // A model of the compulsory memory traffic of one V1 step with the default velocity filter:
@@ -115,9 +102,7 @@ std::size_t step_traffic_bytes(const Simulation<2>& s) {
 
 void BM_V1Step(benchmark::State& state) {
   omp_set_num_threads(static_cast<int>(state.range(1)));
-  const CaseDocument doc = load_case_document(block_case(state.range(0)), {});
-  CaseSetup<2> setup = read_case<2>(doc);
-  Simulation<2> solver(setup);
+  Simulation<2> solver(block_case(state.range(0)));
   const auto t0 = std::chrono::steady_clock::now();
   for (auto _ : state) {
     solver.step();
@@ -150,17 +135,7 @@ BENCHMARK(BM_V1Step)->Args({10000, 1})->Args({100000, 1})->Args({100000, 2})->Ar
 // impermeable free sides (docs/VALIDATION.md, Case 16).
 void BM_V3Step(benchmark::State& state) {
   omp_set_num_threads(static_cast<int>(state.range(1)));
-  const std::string path = block_case(state.range(0), "pore_pressure = 0.0", fmt::format(R"([fluid]
-porosity = 0.3
-density = 1000.0
-bulk_modulus = 1.0e8
-conductivity = 1.0e-6
-[solver]
-version = "v3"
-pressure_filter = {})", state.range(2) != 0 ? 0.5 : 0.0), 0.5);
-  const CaseDocument doc = load_case_document(path, {});
-  CaseSetup<2> setup = read_case<2>(doc);
-  Simulation<2> solver(setup);
+  Simulation<2> solver(block_case(state.range(0), true, state.range(2) != 0 ? 0.5 : 0.0, 0.5));
   for (int k = 0; k < 20; ++k) solver.step();  // past the first steps' PCG transient
   const auto* pressure = solver.scheme().find<PorePressureStage<2>>();
   const PressureSolveStats* stats = pressure != nullptr ? &pressure->stats() : nullptr;
@@ -192,8 +167,7 @@ BENCHMARK(BM_V3Step)->Args({10000, 1, 1})->Args({10000, 1, 0})->Args({100000, 1,
 // the set-up the large-deformation version would repeat every step.
 void BM_OperatorSetup(benchmark::State& state) {
   omp_set_num_threads(1);
-  const CaseDocument doc = load_case_document(block_case(state.range(0)), {});
-  const CaseSetup<2> setup = read_case<2>(doc);
+  const CaseSetup<2> setup = block_case(state.range(0));
   const LatticeParticles<2> disc = generate_lattice<2>(setup.blocks, setup.dx, setup.origin, {2000.0});
   const CubicSplineKernel<2> kernel(setup.h_over_dx * setup.dx);
   for (auto _ : state) {
@@ -209,14 +183,12 @@ void BM_OperatorSetup(benchmark::State& state) {
 }
 BENCHMARK(BM_OperatorSetup)->Arg(100000)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-// The whole set-up of a run: case reading, lattice generation, operators, constraints, state.
+// The whole set-up of a run: lattice generation, operators, constraints, state.
 void BM_V1Setup(benchmark::State& state) {
   omp_set_num_threads(1);
-  const CaseDocument doc = load_case_document(block_case(state.range(0)), {});
   double nodes = 0;
   for (auto _ : state) {
-    CaseSetup<2> setup = read_case<2>(doc);
-    Simulation<2> solver(setup);
+    Simulation<2> solver(block_case(state.range(0)));
     nodes = static_cast<double>(solver.nodes().size());
     benchmark::DoNotOptimize(solver.nodes().position.data());
   }

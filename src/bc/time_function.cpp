@@ -40,6 +40,20 @@ double TimeFunction::operator()(double t) const {
   return value;
 }
 
+TimeFunction TimeFunction::ramp(double duration, double start) {
+  TimeFunction f;
+  f.kind = Kind::ramp;
+  f.duration = duration;
+  f.start = start;
+  return f;
+}
+
+TimeFunction TimeFunction::smoothstep(double duration, double start) {
+  TimeFunction f = ramp(duration, start);
+  f.kind = Kind::smoothstep;
+  return f;
+}
+
 TimeFunction TimeFunction::constant(double v) {
   TimeFunction f;
   f.value = v;

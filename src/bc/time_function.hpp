@@ -13,6 +13,9 @@ class TimeFunction {
   double operator()(double t) const;
 
   static TimeFunction constant(double value = 1.0);
+  /// 0 before `start`, rising linearly (ramp) or by the quintic smoothstep to 1 over `duration`.
+  static TimeFunction ramp(double duration, double start = 0.0);
+  static TimeFunction smoothstep(double duration, double start = 0.0);
 
   Kind kind = Kind::constant;
   double value = 1.0;       // constant level (all kinds scale by it)

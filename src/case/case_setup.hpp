@@ -20,6 +20,23 @@ struct Region {
   std::array<double, Dim> lo{};
   std::array<double, Dim> hi{};
   std::array<bool, Dim> bounded{};
+  /// The plane x_axis = coord (every node on it).
+  static Region plane(int axis, double coord) {
+    Region r;
+    r.lo[static_cast<std::size_t>(axis)] = r.hi[static_cast<std::size_t>(axis)] = coord;
+    r.bounded[static_cast<std::size_t>(axis)] = true;
+    return r;
+  }
+  /// The box [lo, hi] (every axis bounded).
+  static Region box(const Vec<Dim>& lo, const Vec<Dim>& hi) {
+    Region r;
+    for (std::size_t d = 0; d < Dim; ++d) {
+      r.lo[d] = lo[static_cast<int>(d)];
+      r.hi[d] = hi[static_cast<int>(d)];
+      r.bounded[d] = true;
+    }
+    return r;
+  }
   bool contains(const Vec<Dim>& x, double tol) const {
     for (std::size_t d = 0; d < Dim; ++d) {
       if (bounded[d] && (x[static_cast<int>(d)] < lo[d] - tol || x[static_cast<int>(d)] > hi[d] + tol)) return false;
@@ -57,7 +74,7 @@ struct FluidSpec {
   int max_iterations = 2000;
   bool incomplete_cholesky = false;      // preconditioner: false = Jacobi (default)
   bool deferred_correction = true;       // Schwaiger correction on the right-hand side
-  /// Incremental pressure projection (METHOD.md §2.4 "Incremental variant"): the stabilisation
+  /// Incremental pressure projection (method-notes §2.4 "Incremental variant"): the stabilisation
   /// (S_w dt/rho) L acts on p^{n+1} - p^n instead of p^{n+1}.
   bool incremental = true;
   /// solver.pressure_divergence = "stress_points": the storage equation takes div of the stress

@@ -1,0 +1,226 @@
+#pragma once
+// A case made in code (tests, benchmarks, parameter studies): the same CaseSetup the case-file
+// reader makes, without writing TOML. The builder checks what the reader checks about the
+// pieces it assembles (materials named by the blocks, functions named by the loads, the
+// Courant limit); keys it does not set keep the reader's defaults (docs/case-format.md).
+//
+//   CaseSetup<2> c = CaseBuilder<2>("block")
+//                        .spacing(0.1)
+//                        .block({0.0, 0.0}, {10.0, 10.0})
+//                        .elastic(2.0e7, 0.3, 2000.0)
+//                        .fix_velocity(Region<2>::plane(1, 0.0), {0, 1})
+//                        .prescribe_stress(Region<2>::plane(1, 10.0), StressComponent::yy, -1.0e4, "load")
+//                        .function("load", TimeFunction::smoothstep(0.01))
+//                        .time(1.0, 0.9)
+//                        .build();
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "case/case_setup.hpp"
+#include "core/error.hpp"
+#include "materials/material.hpp"
+#include "materials/uniaxial_stress.hpp"
+#include "schemes/registry.hpp"
+#include "schemes/time_step.hpp"
+
+namespace rktsph {
+
+template <int Dim>
+class CaseBuilder {
+ public:
+  explicit CaseBuilder(std::string name = "case built in code") {
+    c_.file = "<" + name + ">";
+    c_.title = std::move(name);
+  }
+
+  CaseBuilder& spacing(double dx) {
+    c_.dx = dx;
+    return *this;
+  }
+  CaseBuilder& origin(const Vec<Dim>& x) {
+    c_.origin = x;
+    return *this;
+  }
+  CaseBuilder& smoothing(double h_over_dx) {
+    c_.h_over_dx = h_over_dx;
+    return *this;
+  }
+  /// A block of cells [min, max] of the named material (the only one if empty).
+  CaseBuilder& block(const Vec<Dim>& min, const Vec<Dim>& max, const std::string& material = "") {
+    blocks_.push_back({min, max, material});
+    return *this;
+  }
+  CaseBuilder& material(std::shared_ptr<const Material> model, const std::string& name = "material") {
+    c_.material_names.push_back(name);
+    c_.materials.push_back(std::move(model));
+    return *this;
+  }
+  CaseBuilder& elastic(double E, double nu, double density, const std::string& name = "material") {
+    return material(std::make_shared<ElasticMaterial>(ElasticConstants::from_E_nu(E, nu, density)), name);
+  }
+  /// 1D: a bar in uniaxial stress instead of uniaxial strain.
+  CaseBuilder& uniaxial_stress() {
+    c_.condition = BarCondition::uniaxial_stress;
+    return *this;
+  }
+  CaseBuilder& function(const std::string& name, TimeFunction f) {
+    c_.function_names.push_back(name);
+    c_.functions.push_back(std::move(f));
+    return *this;
+  }
+  CaseBuilder& gravity(const Vec<Dim>& g, const std::string& function = "") {
+    c_.gravity = g;
+    gravity_function_ = function;
+    return *this;
+  }
+  CaseBuilder& damping(double coefficient, double until = std::numeric_limits<double>::infinity()) {
+    c_.damping = coefficient;
+    c_.damping_until = until;
+    return *this;
+  }
+  /// Prescribed velocity components (axis, m/s) on the nodes of a region.
+  CaseBuilder& prescribe_velocity(const Region<Dim>& region, std::vector<std::pair<int, double>> components,
+                                  const std::string& function = "") {
+    BoundarySpec<Dim>& b = boundary(region, function);
+    b.velocity = std::move(components);
+    return *this;
+  }
+  /// Velocity components held at zero.
+  CaseBuilder& fix_velocity(const Region<Dim>& region, const std::vector<int>& axes) {
+    std::vector<std::pair<int, double>> c;
+    for (int a : axes) c.emplace_back(a, 0.0);
+    return prescribe_velocity(region, std::move(c));
+  }
+  /// A prescribed (total) stress component on the nodes of a region, Pa.
+  CaseBuilder& prescribe_stress(const Region<Dim>& region, StressComponent component, double value,
+                                const std::string& function = "") {
+    BoundarySpec<Dim>& b = boundary(region, function);
+    b.stress.emplace_back(stress_slot<Dim>(component), value);
+    return *this;
+  }
+  /// V3: a drained face (p_w prescribed, Pa).
+  CaseBuilder& drained(const Region<Dim>& region, double pore_pressure = 0.0, const std::string& function = "") {
+    boundary(region, function).pore_pressure = pore_pressure;
+    return *this;
+  }
+  CaseBuilder& initial_stress(const Sym6& uniform) {
+    c_.initial_stress = InitialStressKind::uniform;
+    c_.uniform_stress = uniform;
+    return *this;
+  }
+  CaseBuilder& geostatic(std::optional<double> k0 = std::nullopt) {
+    c_.initial_stress = InitialStressKind::geostatic;
+    c_.k0 = k0;
+    return *this;
+  }
+  /// End time and Courant number.
+  CaseBuilder& time(double end, double cfl = 0.5) {
+    c_.end_time = end;
+    c_.cfl = cfl;
+    c_.dt.reset();
+    return *this;
+  }
+  /// End time and a fixed step.
+  CaseBuilder& time_step(double end, double dt) {
+    c_.end_time = end;
+    c_.dt = dt;
+    c_.cfl.reset();
+    return *this;
+  }
+  /// The scheme by registry name ("v1", "v3", ...).
+  CaseBuilder& scheme(const std::string& version) {
+    c_.version = version;
+    return *this;
+  }
+  CaseBuilder& fluid(const FluidSpec& f) {
+    c_.fluid = f;
+    return *this;
+  }
+  CaseBuilder& velocity_filter(bool on, double strength = 0.5) {
+    c_.filter = on;
+    c_.filter_strength = strength;
+    return *this;
+  }
+
+  /// The case, checked. Throws InputError naming what is missing or inconsistent.
+  CaseSetup<Dim> build() const {
+    CaseSetup<Dim> c = c_;
+    auto fail = [&](const std::string& what) { throw InputError(fmt::format("{}: {}", c.file, what)); };
+    if (!(c.dx > 0.0)) fail("the spacing must be > 0");
+    if (c.materials.empty()) fail("no material");
+    if (blocks_.empty()) fail("no block");
+    if (!(c.end_time > 0.0)) fail("the end time must be > 0");
+    for (std::size_t k = 0; k < blocks_.size(); ++k) {
+      Block<Dim> b{blocks_[k].min, blocks_[k].max, 0, fmt::format("block {}", k)};
+      b.material = material_index(blocks_[k].material, fail);
+      c.blocks.push_back(b);
+    }
+    c.gravity_function = function_index(c, gravity_function_, fail);
+    for (std::size_t k = 0; k < c.boundaries.size(); ++k) {
+      c.boundaries[k].function = function_index(c, boundary_functions_[k], fail);
+    }
+    if (Dim == 1 && c.condition == BarCondition::uniaxial_stress) {
+      for (auto& m : c.materials) m = std::make_shared<UniaxialStressMaterial>(m);
+    }
+    const SchemeInfo* scheme = find_scheme<Dim>(c.version);
+    if (scheme == nullptr) fail(fmt::format("no scheme '{}' in {}D", c.version, Dim));
+    if (scheme->pore_fluid && !(c.fluid.bulk_modulus > 0.0 && c.fluid.porosity > 0.0)) {
+      fail(fmt::format("the scheme '{}' needs a pore fluid (porosity and bulk modulus > 0)", c.version));
+    }
+    const TimeStep step = time_step_from(c.dx, max_wave_speed(c.materials), c.cfl, c.dt);
+    if (step.courant > kMaxCourant) {
+      fail(fmt::format("the Courant number {:.3f} exceeds {} (method-notes §0.3 item 4)", step.courant, kMaxCourant));
+    }
+    return c;
+  }
+
+ private:
+  struct PendingBlock {
+    Vec<Dim> min, max;
+    std::string material;
+  };
+
+  BoundarySpec<Dim>& boundary(const Region<Dim>& region, const std::string& function) {
+    BoundarySpec<Dim> b;
+    b.name = fmt::format("boundary {}", c_.boundaries.size());
+    b.where = c_.file + ", " + b.name;
+    b.region = region;
+    c_.boundaries.push_back(b);
+    boundary_functions_.push_back(function);
+    return c_.boundaries.back();
+  }
+
+  template <class Fail>
+  int material_index(const std::string& name, Fail&& fail) const {
+    if (name.empty()) {
+      if (c_.materials.size() != 1) fail("several materials: name each block's material");
+      return 0;
+    }
+    for (std::size_t i = 0; i < c_.material_names.size(); ++i) {
+      if (c_.material_names[i] == name) return static_cast<int>(i);
+    }
+    fail(fmt::format("no material named '{}'", name));
+    return -1;
+  }
+  template <class Fail>
+  static int function_index(const CaseSetup<Dim>& c, const std::string& name, Fail&& fail) {
+    if (name.empty()) return -1;
+    for (std::size_t i = 0; i < c.function_names.size(); ++i) {
+      if (c.function_names[i] == name) return static_cast<int>(i);
+    }
+    fail(fmt::format("no time function named '{}'", name));
+    return -1;
+  }
+
+  CaseSetup<Dim> c_;
+  std::vector<PendingBlock> blocks_;
+  std::string gravity_function_;
+  std::vector<std::string> boundary_functions_;
+};
+
+}  // namespace rktsph
