@@ -14,7 +14,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 from plot_common import read  # noqa: E402
 
 L_OVER_C = 10.0 / (1.0e7 / 2000.0) ** 0.5
-# CASES.md Case 2, Variant B reference at t_end = 1.8 L/c.
+# docs/cases.md Case 2, Variant B reference at t_end = 1.8 L/c.
 EPS_X = [0.0, 0.05, 0.10, 0.20, 0.30, 0.50, 1.0]
 EPS_REF = [0.0475, 0.0321, 0.0234, 0.0132, 0.0079, 0.0034, 0.0007]
 SIG_X = [1.0, 2.0, 3.0, 5.0, 7.0, 9.5]
@@ -41,13 +41,13 @@ def main(d):
         r = read(p)
         dx = spacing(p, "profile_gamma1e4_dx")
         axes[0].plot(r["x"], r["eps_vp_eq"], ":", label=f"diagnostic $\\gamma_f$ = 1e4 1/s, dx = {dx} m")
-    axes[0].plot(EPS_X, EPS_REF, "ko", mfc="none", label="reference (CASES.md, Variant B)")
+    axes[0].plot(EPS_X, EPS_REF, "ko", mfc="none", label="reference (docs/cases.md, Variant B)")
     axes[0].axhline(0.0475 / 2, color="grey", lw=0.6, ls="--")
     axes[0].set_xlim(0, 1.0)
     axes[0].set_xlabel("x (m)")
     axes[0].set_ylabel("accumulated viscoplastic strain $\\bar\\varepsilon^{vp}$ (-)")
     axes[0].set_title("$\\bar\\varepsilon^{vp}$ near the fixed end, t = 1.8 L/c")
-    axes[1].plot(SIG_X, SIG_REF, "ko", mfc="none", label="reference (CASES.md, Variant B)")
+    axes[1].plot(SIG_X, SIG_REF, "ko", mfc="none", label="reference (docs/cases.md, Variant B)")
     axes[1].set_xlabel("x (m)")
     axes[1].set_ylabel("axial stress $\\sigma$ (kPa)")
     axes[1].set_title("$\\sigma$ along the bar, t = 1.8 L/c")

@@ -45,7 +45,7 @@ def main(d):
     axes[0].set_ylabel("q of the average stress (kPa)")
     axes[1].set_ylabel("p' of the average effective stress (kPa)")
     axes[2].set_ylabel("mean excess pore pressure $\\Delta p_w$ (kPa)")
-    axes[3].axhline(0.2, color="r", ls=":", label="CASES.md no-band limit at 8 % (k = 1e-9)")
+    axes[3].axhline(0.2, color="r", ls=":", label="docs/cases.md no-band limit at 8 % (k = 1e-9)")
     axes[3].set_ylabel("coefficient of variation of $\\bar\\varepsilon^{vp}$ (-)")
     axes[3].set_ylim(0, 2)
     for ax in axes:

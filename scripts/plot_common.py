@@ -18,7 +18,7 @@ def read(path):
 
 def style_crest_history(axes, height, marks):
     """Axes of a cut's crest displacement (axes[0]) and kinetic energy (axes[1], log) against t:
-    the collapse threshold 0.05 H of CASES.md §1.3, labels, and vertical lines at the times of
+    the collapse threshold 0.05 H of docs/cases.md §1.3, labels, and vertical lines at the times of
     `marks`, a list of (t, line style, label)."""
     top = max(max(line.get_ydata()) for line in axes[1].get_lines())
     axes[1].set_ylim(bottom=1e-6 * top)

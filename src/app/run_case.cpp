@@ -268,7 +268,7 @@ int run_dim(const RunOptions& opt, const CaseDocument& doc) {
   summary["peak_kinetic_energy"] = solver.clock().peak_kinetic_energy();
   if (pressure != nullptr) {
     const PressureSolveStats* ps = &pressure->stats();
-    // V3: the pore-pressure solve (METHOD.md §2.4): PCG iterations, residual, time share.
+    // V3: the pore-pressure solve (method-notes §2.4): PCG iterations, residual, time share.
     summary["pressure_solve"] = {
         {"preconditioner", setup.fluid.incomplete_cholesky ? "incomplete_cholesky" : "jacobi"},
         {"tolerance", setup.fluid.tolerance},

@@ -1,5 +1,5 @@
 #pragma once
-// Cubic B-spline kernel of Monaghan & Lattanzio (METHOD.md §3.1), support radius 2h.
+// Cubic B-spline kernel of Monaghan & Lattanzio (method-notes §3.1), support radius 2h.
 #include <cmath>
 #include <numbers>
 
@@ -15,7 +15,7 @@ class CubicSplineKernel {
   double h() const { return h_; }
   double support_radius() const { return 2.0 * h_; }
 
-  /// W(r, h) (METHOD.md §3.1).
+  /// W(r, h) (method-notes §3.1).
   double value(double r) const {
     const double q = r / h_;
     if (q < 1.0) return alpha_ * (2.0 / 3.0 - q * q + 0.5 * q * q * q);
@@ -26,7 +26,7 @@ class CubicSplineKernel {
     return 0.0;
   }
 
-  /// dW/dr (METHOD.md §3.1).
+  /// dW/dr (method-notes §3.1).
   double derivative(double r) const {
     const double q = r / h_;
     if (q < 1.0) return alpha_ / h_ * (-2.0 * q + 1.5 * q * q);

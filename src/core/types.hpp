@@ -26,10 +26,6 @@ using Mat = Eigen::Matrix<double, Dim, Dim>;
 template <int Dim>
 inline constexpr int kStressComponents = Dim == 1 ? 3 : (Dim == 2 ? 4 : 6);
 
-/// Number of components of the hyperbolic state vector Phi = (v, sigma) per particle.
-template <int Dim>
-inline constexpr int kStateComponents = Dim + kStressComponents<Dim>;
-
 /// A full symmetric tensor in the 3D Voigt order (xx, yy, zz, xy, yz, xz), tensor (not
 /// engineering) shear components. Materials work on this form whatever the dimension.
 using Sym6 = std::array<double, 6>;

@@ -1,6 +1,6 @@
 #pragma once
 // Hardening parts of the Perzyna models: they own the history variables, give the current
-// yield size Y, and their rates from the viscoplastic strain rate (METHOD.md §1.7–1.9).
+// yield size Y, and their rates from the viscoplastic strain rate (method-notes §1.7–1.9).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -11,12 +11,12 @@
 
 namespace rktsph {
 
-/// Y = max(Y0 + H eps_vp_eq, Y_res) (METHOD.md §1.7, §1.9); H < 0 softens. State:
+/// Y = max(Y0 + H eps_vp_eq, Y_res) (method-notes §1.7, §1.9); H < 0 softens. State:
 /// eps_vp_eq = int sqrt(2/3 e_vp:e_vp) dt (dimensionless).
 struct LinearHardening {
   double Y0 = 0.0;        // initial yield stress, Pa
   double H = 0.0;         // hardening modulus, Pa (negative = softening)
-  double Y_residual = 0;  // floor of Y, Pa (METHOD.md §6 item 12: a parameter, default 0.1 Y0)
+  double Y_residual = 0;  // floor of Y, Pa (method-notes §6 item 12: a parameter, default 0.1 Y0)
 
   static constexpr int kSize = 1;
   static std::array<std::string, kSize> names() { return {"eps_vp_eq"}; }
@@ -33,7 +33,7 @@ struct LinearHardening {
 };
 
 /// Cam-Clay: p_c_dot = -p_c (1 + e0)/(lambda - kappa) tr(eps_vp_dot), tr positive in dilation
-/// (METHOD.md §1.8), so compaction hardens and dilation softens. State: eps_vp_eq,
+/// (method-notes §1.8), so compaction hardens and dilation softens. State: eps_vp_eq,
 /// eps_vp_vol = tr(eps_vp) (positive in dilation, like every strain here), p_c (Pa).
 struct CamClayHardening {
   double v0_over_lambda_kappa = 0.0;  // (1 + e0)/(lambda - kappa)

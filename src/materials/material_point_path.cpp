@@ -141,7 +141,7 @@ PathResult integrate_path(const Material& material, const Sym6& sigma0, const Lo
   double t = 0.0;
   for (long step = 0; step < nsteps; ++step) {
     const double dt = std::min(dt_nominal, path.duration - t);
-    // Stiffness at the start and at the elastic trial end point (METHOD.md §4.3): inside the
+    // Stiffness at the start and at the elastic trial end point (method-notes §4.3): inside the
     // surface the rate is 0, but the loading can carry the point outside within the step.
     rate(sig, k.data(), ds[0], dummy, kel.data(), false);
     for (std::size_t c = 0; c < 6; ++c) sst[c] = sig[c] + dt * ds[0][c];

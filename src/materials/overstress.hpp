@@ -1,7 +1,7 @@
 #pragma once
 // Perzyna overstress functions Phi(x) of the normalised overstress x = (F - Y)/Y
-// (METHOD.md §1.6). The Macaulay bracket is built in: Phi = 0 for x <= dead_band. The dead band
-// defaults to 0 (METHOD.md §6 item 12); when a case asks for one, flow starts once x exceeds
+// (method-notes §1.6). The Macaulay bracket is built in: Phi = 0 for x <= dead_band. The dead band
+// defaults to 0 (method-notes §6 item 12); when a case asks for one, flow starts once x exceeds
 // it and Phi is NOT shifted (the lineage behaviour: Phi jumps from 0 to Phi(dead_band)).
 #include <algorithm>
 #include <cmath>

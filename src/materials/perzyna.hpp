@@ -1,5 +1,5 @@
 #pragma once
-// Perzyna viscoplasticity composed of parts (METHOD.md §1.6):
+// Perzyna viscoplasticity composed of parts (method-notes §1.6):
 //   eps_vp_dot = gamma <Phi((F - Y)/Y)> m,   dsigma/dt = -D^e : eps_vp_dot,
 // with a yield-surface part (F, dF/dsigma, flow vector m), an overstress part (Phi) and a
 // hardening part (history variables, Y and their rates). A new surface is one small header
@@ -55,7 +55,7 @@ class PerzynaMaterial final : public Material {
   }
 
   /// Linearised relaxation rate of the normalised overstress x = (F - Y)/Y along the flow
-  /// (METHOD.md §4.3): gamma Phi'(x) [dF/dsigma : D^e : m + (1 + x)|dY/d(gamma Phi)|] / Y.
+  /// (method-notes §4.3): gamma Phi'(x) [dF/dsigma : D^e : m + (1 + x)|dY/d(gamma Phi)|] / Y.
   /// von Mises, N = 1, H = 0 gives 3 G gamma / Y; Cam-Clay gives gamma K M^2/p_c on the
   /// isotropic axis (plus the hardening term gamma M^2 (1+e0)/(lambda-kappa)) and about
   /// 6 G gamma/p_c at the critical state. Zero inside the surface.
@@ -93,7 +93,7 @@ class PerzynaMaterial final : public Material {
       for (int j = 0; j < Hardening::kSize; ++j) dstate[j] = 0.0;
       return;
     }
-    // eps_vp_dot in tensor components; D^e.apply gives sigma_xy = 2 G eps_xy (METHOD.md §1.6).
+    // eps_vp_dot in tensor components; D^e.apply gives sigma_xy = 2 G eps_xy (method-notes §1.6).
     const Sym6 evp = tensor::scaled(surface_.flow(sigma, Y), fluidity_ * phi);
     const Sym6 d = elastic().apply(evp);
     for (std::size_t i = 0; i < 6; ++i) dsigma[i] = -d[i];

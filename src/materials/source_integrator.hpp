@@ -1,5 +1,5 @@
 #pragma once
-// RK4 integration of the pointwise source ODE for a batch of particles (METHOD.md §2.2,
+// RK4 integration of the pointwise source ODE for a batch of particles (method-notes §2.2,
 // §4.3), written once as a template so that a model can call it with its non-virtual rate
 // (the fast path of PerzynaMaterial) while Material::advance_source calls it through the
 // virtual interface.
@@ -40,7 +40,7 @@ SourceStats integrate_source_batch(double tau, const SourceBatch& b, int nk, Rat
 
     // The relaxation rate is zero inside the surface; with the frozen flux the loading R can
     // carry an elastic start far outside within the step, so also look at the elastic
-    // trial end point s0 + tau R (METHOD.md §4.3).
+    // trial end point s0 + tau R (method-notes §4.3).
     double lam = relax(s, k);
     if (frozen) {
       Sym6 trial;
@@ -65,7 +65,7 @@ SourceStats integrate_source_batch(double tau, const SourceBatch& b, int nk, Rat
     double kt[kMaxState];
     constexpr double kFrac[4] = {0.0, 0.5, 0.5, 1.0};
     for (long sub = 0; sub < substeps; ++sub) {
-      // Classical RK4 stages; the frozen flux rate joins the ODE when chosen (METHOD.md §2.2).
+      // Classical RK4 stages; the frozen flux rate joins the ODE when chosen (method-notes §2.2).
       for (int stage = 0; stage < 4; ++stage) {
         if (stage == 0) {
           st = s;

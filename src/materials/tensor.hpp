@@ -36,7 +36,7 @@ inline double determinant(const Sym6& a) {
   return xx * (yy * zz - yz * yz) - xy * (xy * zz - yz * xz) + xz * (xy * yz - yy * xz);
 }
 
-/// Equivalent strain (rate) sqrt(2/3 e:e) of the deviatoric part e (METHOD.md §1.7).
+/// Equivalent strain (rate) sqrt(2/3 e:e) of the deviatoric part e (method-notes §1.7).
 inline double equivalent_strain(const Sym6& eps) {
   const Sym6 e = deviator(eps);
   return std::sqrt(2.0 / 3.0 * ddot(e, e));

@@ -26,7 +26,7 @@ void UniaxialStressMaterial::source_rate(const Sym6& sigma, const double* state,
 
 double UniaxialStressMaterial::relaxation_rate(const Sym6& sigma, const double* state) const {
   // The wrapped model's estimate (3 G gamma / Y for von Mises) bounds the uniaxial one
-  // (E gamma / Y) for nu >= 0: a conservative sub-stepping (METHOD.md §4.3).
+  // (E gamma / Y) for nu >= 0: a conservative sub-stepping (method-notes §4.3).
   return inner_->relaxation_rate(uniaxial(sigma), state);
 }
 

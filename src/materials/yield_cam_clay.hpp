@@ -1,5 +1,5 @@
 #pragma once
-// Modified Cam-Clay surface (METHOD.md §1.8, CASES.md §1.2 C3). Scalar form used in the
+// Modified Cam-Clay surface (method-notes §1.8, docs/cases.md §1.2 C3). Scalar form used in the
 // overstress: F = p' + q^2/(M^2 p') (the "equivalent size" P_y), Y = p_c. The flow vector is
 // the gradient of the ellipse f = q^2 + M^2 p'(p' - p_c), scaled by 1/p_c (dimensionless).
 //
@@ -7,7 +7,7 @@
 // sin(phi_c) = 3 M_c/(6 + M_c) so that M = M_c in triaxial compression (theta = +30 deg,
 // tension-positive stress). Its gradient is taken through x = sin(3 theta) directly:
 //   dx/dsigma = -(3 sqrt3/2) J2^(-3/2) [t - 3 J3/(2 J2) s],  t = s.s - 2/3 J2 1,
-// which is the METHOD.md form times 3 cos(3 theta): the cos(3 theta) cancels, so the
+// which is the lineage form of method-notes §1.8 times 3 cos(3 theta): the cos(3 theta) cancels, so the
 // Owen–Hinton cut-off at |theta| > 29 deg is not needed. Only J2 -> 0 is guarded (the
 // deviatoric direction is undefined there, and q^2 -> 0 removes M from F anyway).
 #include <algorithm>
@@ -23,7 +23,7 @@ struct CamClaySurface {
   double M_c = 1.0;             // critical-state slope in triaxial compression
   bool lode_dependent = false;  // M(theta) instead of constant M_c
 
-  /// Tension guard (METHOD.md §1.8): for p' <= kTensionGuard * p_c, F = p' (no q term).
+  /// Tension guard (method-notes §1.8): for p' <= kTensionGuard * p_c, F = p' (no q term).
   static constexpr double kTensionGuard = 1e-6;
   /// Below q = kLodeGuard * p_c the Lode angle is undefined and M = M_c is used.
   static constexpr double kLodeGuard = 1e-9;
@@ -79,7 +79,7 @@ struct CamClaySurface {
     return g;
   }
 
-  /// m = (1/p_c)[-(M^2/3)(2p' - p_c) 1 + 3 s + 2 M p'(p' - p_c) dM/dsigma] (METHOD.md §1.8).
+  /// m = (1/p_c)[-(M^2/3)(2p' - p_c) 1 + 3 s + 2 M p'(p' - p_c) dM/dsigma] (method-notes §1.8).
   Sym6 flow(const Sym6& sigma, double Y) const {
     const double p = -tensor::trace(sigma) / 3.0;
     const Sym6 s = tensor::deviator(sigma);
@@ -93,7 +93,7 @@ struct CamClaySurface {
     return m;
   }
 
-  /// sin(phi_c) -> M_c in triaxial compression (CASES.md §1.2 C3).
+  /// sin(phi_c) -> M_c in triaxial compression (docs/cases.md §1.2 C3).
   static double M_from_friction_angle(double phi_deg) {
     const double s = std::sin(phi_deg * std::numbers::pi / 180.0);
     return 6.0 * s / (3.0 - s);

@@ -1,5 +1,5 @@
 #pragma once
-// von Mises yield surface F = q = sqrt(3 J2) with Y the current yield stress (METHOD.md §1.7).
+// von Mises yield surface F = q = sqrt(3 J2) with Y the current yield stress (method-notes §1.7).
 #include "core/types.hpp"
 #include "materials/tensor.hpp"
 
@@ -9,7 +9,7 @@ struct VonMisesSurface {
   /// F(sigma) in Pa; Y (the current size) is not needed by this surface.
   double value(const Sym6& sigma, double /*Y*/) const { return invariants(sigma).q; }
 
-  /// dF/dsigma = 3 s/(2q), tensor components (METHOD.md §1.7). Zero at q = 0, where the
+  /// dF/dsigma = 3 s/(2q), tensor components (method-notes §1.7). Zero at q = 0, where the
   /// direction is undefined but no flow can occur (Y > 0).
   Sym6 gradient(const Sym6& sigma, double /*Y*/) const {
     const Sym6 s = tensor::deviator(sigma);

@@ -1,5 +1,5 @@
 #pragma once
-// Cell list (METHOD.md §3.8, the cell linked list stored as sorted arrays): the bounding box is
+// Cell list (method-notes §3.8, the cell linked list stored as sorted arrays): the bounding box is
 // split into square cells of side equal to the search radius (or a fraction of it), and a query
 // scans its own cell and the 3^Dim (5^Dim, ...) around it. Built once in the small-deformation solvers; cheap enough to rebuild every
 // step when particles move.

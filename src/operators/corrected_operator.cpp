@@ -155,7 +155,7 @@ struct PatternTable {
   }
 };
 
-// The weights M_a^{-1} V_b [W_ab; h grad_a W_ab] of one row (METHOD.md §3.2), in units of h so
+// The weights M_a^{-1} V_b [W_ab; h grad_a W_ab] of one row (method-notes §3.2), in units of h so
 // that the (n_d+1) system is well scaled. Returns false if the row is degenerate.
 template <int Dim>
 bool row_weights(const std::vector<Pair<Dim>>& pairs, const ParticleSet<Dim>& sources,
@@ -193,7 +193,7 @@ bool row_weights(const std::vector<Pair<Dim>>& pairs, const ParticleSet<Dim>& so
       c = Minv * basis[k];
     } else {
       // Too few sources for the corrected system: Shepard interpolation and the plain
-      // kernel gradient (METHOD.md §3.2 guard).
+      // kernel gradient (method-notes §3.2 guard).
       c = basis[k];
       c[0] = shepard > 0.0 ? basis[k][0] / shepard : 0.0;
     }

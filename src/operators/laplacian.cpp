@@ -77,7 +77,7 @@ NodeLaplacian<Dim> build_node_laplacian(const Relation<Dim>& relation, const Par
       A -= gw * p.x_ij.transpose();  // grad_I W_IJ (x) (x_J - x_I)
       g += gw;
     }
-    // Singularity guard (METHOD.md §3.5): A is dimensionless, about the identity inside, about
+    // Singularity guard (method-notes §3.5): A is dimensionless, about the identity inside, about
     // 1/2 along the normal at a wall; a small determinant relative to the trace means too few
     // neighbours on one side (c_I = 2, no gradient correction).
     const double det = A.determinant();

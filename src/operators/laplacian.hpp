@@ -1,6 +1,6 @@
 #pragma once
-// Schwaiger's corrected SPH Laplacian on the node set (METHOD.md §3.5), for the pore-pressure
-// equation of the V3 saturated solver (METHOD.md §2.4, §5.3).
+// Schwaiger's corrected SPH Laplacian on the node set (method-notes §3.5), for the pore-pressure
+// equation of the V3 saturated solver (method-notes §2.4, §5.3).
 //
 // With F_IJ = W'(r_IJ)/r_IJ (< 0), the CSPM matrix A_I = sum_J V_J grad_I W_IJ (x) (x_J - x_I)
 // (= -Gamma_I), c_I = (2/n_d) tr A_I^{-1} and g_I = sum_J V_J grad_I W_IJ:
@@ -18,9 +18,9 @@
 // derivative (zero) replaces the computed one in the correction, i.e. grad f_I is projected on
 // the wall's tangent plane, P = I - n n. The row then evaluates the Laplacian of the even
 // (mirror) extension of f across the wall - the discrete counterpart of dp/dn = 0
-// (METHOD.md §4.1: mirror nodes carrying p_mirror = p across straight walls).
+// (method-notes §4.1: mirror nodes carrying p_mirror = p across straight walls).
 //
-// Symmetric part (for the SPD matrix of the PCG, METHOD.md §3.5 "recommended approach"):
+// Symmetric part (for the SPD matrix of the PCG, method-notes §3.5 "recommended approach"):
 //   S_IJ = 1/2 (c_I + c_J) * 1/2 (V_I + V_J) * (-F_IJ)  (J != I),  S_II = -sum_J S_IJ,
 // the Brookshaw sum with symmetrised weights. S is symmetric negative semi-definite (a weighted
 // graph Laplacian). The difference L - S is applied to the previous pressure (deferred
@@ -40,7 +40,7 @@ namespace rktsph {
 
 /// An impermeable straight wall x_axis = coord, the body on the side opposite to `outward`
 /// (+1: outward normal +e_axis). Neighbours are mirrored across it (even extension, p_J' = p_J,
-/// METHOD.md §4.1), which restores a full support near the wall.
+/// method-notes §4.1), which restores a full support near the wall.
 struct MirrorPlane {
   int axis = 0;
   double coord = 0.0;
@@ -62,7 +62,7 @@ struct NodeLaplacian {
 /// within the kernel support of the wall (a neighbour ON the wall is its own image and so
 /// counts twice: it stands for its real and its mirrored half-volume). With mirrors, a row
 /// next to a wall sees a full support: A_I ~ 1 and the isotropic normalisation of Schwaiger's
-/// formula holds, which it does not for a one-sided, anisotropic support (METHOD.md §3.5
+/// formula holds, which it does not for a one-sided, anisotropic support (method-notes §3.5
 /// table: 2.25 instead of 4 at an edge). Images across two walls (corners) are not added.
 /// `mirror_mask[I]` (may be empty = all) selects, bit k, the planes mirrors[k] used at node I
 /// (at most 8 planes), so that a plane that is impermeable only in part (a footing on a drained

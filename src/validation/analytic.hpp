@@ -1,10 +1,10 @@
 #pragma once
-// Closed-form reference solutions used by the validation cases (CASES.md).
+// Closed-form reference solutions used by the validation cases (docs/cases.md).
 #include <cmath>
 
 namespace rktsph::analytic {
 
-/// Quintic smooth step S(tau) = 10 tau^3 - 15 tau^4 + 6 tau^5 on [0, 1] (CASES.md Case 1,
+/// Quintic smooth step S(tau) = 10 tau^3 - 15 tau^4 + 6 tau^5 on [0, 1] (docs/cases.md Case 1,
 /// revised acceptance); a rise time of zero gives the Heaviside step.
 inline double smooth_step(double t, double rise_time) {
   if (t < 0.0) return 0.0;
@@ -14,7 +14,7 @@ inline double smooth_step(double t, double rise_time) {
 }
 
 /// 1D elastic bar 0 <= x <= L, fixed at x = 0, traction sigma0 S(t) at x = L: stress and
-/// velocity by the method of images (CASES.md Case 1).
+/// velocity by the method of images (docs/cases.md Case 1).
 struct ElasticBar {
   double length;      // m
   double wave_speed;  // m/s

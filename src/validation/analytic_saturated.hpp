@@ -1,5 +1,5 @@
 #pragma once
-// Closed-form references of the saturated (V3) validation cases (CASES.md Cases 13 and 14),
+// Closed-form references of the saturated (V3) validation cases (docs/cases.md Cases 13 and 14),
 // for the u-p_w model (C4) in one dimension. z is the depth from the drained, loaded top.
 #include <array>
 #include <cmath>
@@ -10,7 +10,7 @@
 
 namespace rktsph::analytic {
 
-/// Column constants shared by both cases (CASES.md C4 and Case 13).
+/// Column constants shared by both cases (docs/cases.md C4 and Case 13).
 struct SaturatedColumn {
   double height = 10.0;         // H = L, m
   double constrained = 0.0;     // drained constrained modulus M, Pa
@@ -25,7 +25,7 @@ struct SaturatedColumn {
   double time_factor(double t) const { return cv() * t / (height * height); }
 };
 
-/// Terzaghi consolidation (CASES.md Case 13) under a load ramped linearly from 0 to q over
+/// Terzaghi consolidation (docs/cases.md Case 13) under a load ramped linearly from 0 to q over
 /// `ramp` seconds (exact convolution of the step solution with the ramp; ramp = 0: a step).
 struct Terzaghi {
   SaturatedColumn col;
@@ -72,7 +72,7 @@ struct Terzaghi {
   double final_settlement() const { return load * col.height / col.constrained; }
 };
 
-/// Exact steady state of the harmonically loaded column (CASES.md Case 14): top z = 0 drained
+/// Exact steady state of the harmonically loaded column (docs/cases.md Case 14): top z = 0 drained
 /// and loaded by the total compressive stress q0 e^{i omega t}; base z = L fixed, impermeable.
 /// u is the downward displacement.
 struct HarmonicColumn {

@@ -1,6 +1,6 @@
 #pragma once
-// Shared by the sample-localisation cases 3 and 16 (CASES.md Cases 3 and 16): the band angle of
-// CASES.md §1.3 from a nodal plastic-strain field.
+// Shared by the sample-localisation cases 3 and 16 (docs/cases.md Cases 3 and 16): the band angle of
+// docs/cases.md §1.3 from a nodal plastic-strain field.
 #include <cstddef>
 #include <string>
 #include <vector>
@@ -9,7 +9,7 @@
 
 namespace rktsph::validation {
 
-/// The plane-strain sample and platen loading of CASES.md Case 3, which Case 16 reuses: 1 m x
+/// The plane-strain sample and platen loading of docs/cases.md Case 3, which Case 16 reuses: 1 m x
 /// 2 m, the top platen driven down at 0.1 m/s reached by a linear ramp over 0.1 s.
 constexpr double kSampleHeight = 2.0, kSampleWidth = 1.0;
 constexpr double kPlatenRampTime = 0.1, kPlatenSpeed = 0.1;
@@ -31,7 +31,7 @@ inline double platen_time(double strain) {
 HistoryView node_history(const Simulation<2>& solver, const std::string& name, const std::string& who);
 
 /// The band fitted to the cloud of nodes where eps >= 50 % of its maximum inside the band
-/// region (CASES.md §1.3).
+/// region (docs/cases.md §1.3).
 struct BandFit {
   double angle = 0.0;    // degrees to the horizontal: the pair's mean arm angle, or the whole cloud's axis
   double whole = 0.0;    // principal axis of the whole cloud, degrees

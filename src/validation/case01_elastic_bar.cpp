@@ -1,4 +1,4 @@
-// Thesis case 1: 1D elastic bar, test of stability (CASES.md Case 1, revised acceptance).
+// Thesis case 1: 1D elastic bar, test of stability (docs/cases.md Case 1, revised acceptance).
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -192,9 +192,9 @@ CaseReport validate_case01(const Options& opt, const std::string& dir) {
   CaseReport rep;
   rep.id = "01";
   rep.title = "1D elastic bar: test of stability (V1)";
-  rep.reference = "exact image-series solution (CASES.md Case 1), revised acceptance";
+  rep.reference = "exact image-series solution (docs/cases.md Case 1), revised acceptance";
   const std::string case_file = (fs::path(opt.cases_dir) / "01_elastic_bar_1d.toml").string();
-  const double c_max = 1.2;  // largest Courant number claimed in 1D (METHOD.md §0.3 item 4)
+  const double c_max = 1.2;  // largest Courant number claimed in 1D (method-notes §0.3 item 4)
 
   // ---- accuracy on the smooth load, three resolutions
   const std::vector<int> ns = {100, 200, 400};
@@ -276,7 +276,7 @@ CaseReport validate_case01(const Options& opt, const std::string& dir) {
   rep.metrics.push_back(metric("step load: e1 decreases with N at every snapshot (1 = yes)", decreasing ? 1.0 : 0.0, ">=", 1.0, ""));
   rep.metrics.push_back(metric("tension/compression mirror: max |s_t + s_c| / sigma0", mirror, "<=", 1e-9, ""));
 
-  // ---- single-set (collocated) comparison, reported only (METHOD.md §0.3 item 6)
+  // ---- single-set (collocated) comparison, reported only (method-notes §0.3 item 6)
   {
     BarRun smooth{100, 0.5, 1.0, true, true, 3.5 * kTransit};
     const BarResult s = run_bar(smooth, case_file, {3.5});
@@ -289,7 +289,7 @@ CaseReport validate_case01(const Options& opt, const std::string& dir) {
     rep.notes.push_back(st.blew_up ? fmt::format("the single-set run blew up at {:.2f} L/c", st.blow_up_time)
                                    : "the single-set run stayed bounded over 20 L/c (fixed particles: the problem is linear, so "
                                      "this compares time integration and boundary closure, not the tensile instability; "
-                                     "see METHOD.md §0.3 item 6)");
+                                     "see method-notes §0.3 item 6)");
   }
   std::string note;
   if (opt.plots && run_plot_script("plot_case01.py", dir, note)) {

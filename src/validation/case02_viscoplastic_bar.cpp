@@ -1,4 +1,4 @@
-// Thesis case 2: 1D viscoplastic bar with softening, strain localisation (CASES.md Case 2,
+// Thesis case 2: 1D viscoplastic bar with softening, strain localisation (docs/cases.md Case 2,
 // Variant B: overstress normalised by the current yield size, H_s = -0.02E).
 #include <algorithm>
 #include <cmath>
@@ -24,7 +24,7 @@ const double kTransit = kL / kC;  // L/c, s
 const double kV0 = 0.75 * kSigmaY0 / (kRho * kC);
 const double kEnd = 1.8 * kTransit;
 
-// CASES.md Case 2 reference, Variant B, at t_end = 1.8 L/c.
+// docs/cases.md Case 2 reference, Variant B, at t_end = 1.8 L/c.
 constexpr double kRefIntegral = 8.27e-3;  // m
 constexpr double kRefMax = 0.0475;
 constexpr double kRefW50Lo = 0.096, kRefW50Hi = 0.10;          // m
@@ -102,7 +102,7 @@ BarResult run_bar(const std::string& case_file, double dx, double fluidity) {
       out.integral_t.push_back(integral_now());
     }
     if (n == half_transit) {
-      // CASES.md Case 2: before L/c the elastic wave must meet the case-1 criteria.
+      // docs/cases.md Case 2: before L/c the elastic wave must meet the case-1 criteria.
       const double t = solver.time();
       const double front_exact = kL - kC * t;
       double num = 0.0, den = 0.0, smax = 0.0, front = kL;
@@ -180,13 +180,13 @@ CaseReport validate_case02(const Options& opt, const std::string& dir) {
   CaseReport rep;
   rep.id = "02";
   rep.title = "1D viscoplastic bar with softening, strain localisation (V1)";
-  rep.reference = "converged 1-D finite-difference reference of CASES.md Case 2, Variant B "
+  rep.reference = "converged 1-D finite-difference reference of docs/cases.md Case 2, Variant B "
                   "(current-size normalisation, H_s = -0.02E), at t_end = 1.8 L/c";
   const std::string case_file = (fs::path(opt.cases_dir) / "02_viscoplastic_bar_1d.toml").string();
   constexpr double kFluidity = 2.0;
   constexpr double kBaseline = 0.01;
 
-  // CASES.md: baseline dx = 0.01 m with 0.02 and 0.005; --quick leaves out 0.005.
+  // docs/cases.md: baseline dx = 0.01 m with 0.02 and 0.005; --quick leaves out 0.005.
   std::vector<double> spacings = {0.02, 0.01};
   if (opt.full) spacings.push_back(0.005);
   std::vector<BarResult> runs;
@@ -227,7 +227,7 @@ CaseReport validate_case02(const Options& opt, const std::string& dir) {
     if (kEpsX[k] <= 0.3) eps_err = std::max(eps_err, std::abs(e - kEpsRef[k]) / kEpsRef[k]);
     eps_list += fmt::format("{}{:.4f}", k ? " / " : "", e);
   }
-  rep.metrics.push_back(metric("dx = 0.01: max relative error of eps_vp_eq at x = 0.05-0.30 m (no tolerance in CASES.md)", eps_err, "", 0, ""));
+  rep.metrics.push_back(metric("dx = 0.01: max relative error of eps_vp_eq at x = 0.05-0.30 m (no tolerance in docs/cases.md)", eps_err, "", 0, ""));
   rep.notes.push_back(fmt::format("dx = 0.01: eps_vp_eq at x = 0.05 / 0.10 / 0.20 / 0.30 / 0.50 / 1.0 m = {} "
                                   "(reference 0.0321 / 0.0234 / 0.0132 / 0.0079 / 0.0034 / 0.0007)", eps_list));
   rep.metrics.push_back(metric("dx = 0.01: position of max eps_vp_eq (band at x = 0)", b.x_max / b.dx, "<=", 0.0, "dx"));
@@ -252,7 +252,7 @@ CaseReport validate_case02(const Options& opt, const std::string& dir) {
                                b.overshoot, "", 0, ""));
   rep.metrics.push_back(metric("dx = 0.01: e1(sigma) of the elastic step at 0.5 L/c", b.e1_elastic, "", 0, ""));
   if (opt.full) {
-    // Diagnostic (CASES.md): almost rate-independent, the band should shrink with dx.
+    // Diagnostic (docs/cases.md): almost rate-independent, the band should shrink with dx.
     std::string diag;
     for (double dx : {0.02, 0.01}) {
       const BarResult d = run_bar(case_file, dx, 1.0e4);

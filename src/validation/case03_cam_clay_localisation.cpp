@@ -1,4 +1,4 @@
-// Thesis case 3: strain localisation in a 2D plane-strain Cam-Clay sample (CASES.md Case 3,
+// Thesis case 3: strain localisation in a 2D plane-strain Cam-Clay sample (docs/cases.md Case 3,
 // acceptance set-up): closed-form elastic path and first yield, softening, band angle.
 #include <algorithm>
 #include <cmath>
@@ -20,11 +20,11 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// CASES.md Case 3 material and loading.
+// docs/cases.md Case 3 material and loading.
 constexpr double kE = 2.0e7, kNu = 0.3, kM = 1.2, kP0 = 5.0e4, kPc0 = 4.0e5;
 constexpr double kHeight = kSampleHeight, kWidth = kSampleWidth;
 
-/// Closed-form elastic path (CASES.md Case 3): s = sigma_1 - sigma_3, compression positive.
+/// Closed-form elastic path (docs/cases.md Case 3): s = sigma_1 - sigma_3, compression positive.
 struct ElasticPath {
   double root = std::sqrt(1.0 - kNu + kNu * kNu);
   double q(double s) const { return s * root; }
@@ -60,7 +60,7 @@ struct SampleResult {
   long max_substeps = 0;
 };
 
-// Band angle (CASES.md §1.3, validation/band_common.hpp): threshold eps_vp_eq at 50 % of its
+// Band angle (docs/cases.md §1.3, validation/band_common.hpp): threshold eps_vp_eq at 50 % of its
 // maximum inside the band region, here the sample without the 0.1 m next to each platen, and
 // fit the principal axis (arm by arm for a conjugate pair).
 void band_angle(const Snapshot& s, SampleResult& r) {
@@ -206,7 +206,7 @@ CaseReport validate_case03(const Options& opt, const std::string& dir) {
   CaseReport rep;
   rep.id = "03";
   rep.title = "2D Cam-Clay plane-strain compression, strain localisation (V1)";
-  rep.reference = "closed-form elastic path and first yield of CASES.md Case 3 (constant M), "
+  rep.reference = "closed-form elastic path and first yield of docs/cases.md Case 3 (constant M), "
                   "band-angle bounds 43-68 deg";
   const std::string case_file = (fs::path(opt.cases_dir) / "03_cam_clay_localisation_2d.toml").string();
   const ElasticPath path;
@@ -224,9 +224,9 @@ CaseReport validate_case03(const Options& opt, const std::string& dir) {
                                   "elastic slope dq/deps_a = {:.4g} MPa",
                                   s_y / 1e3, q_y / 1e3, path.p(s_y) / 1e3, 100 * eps_y, path.slope() / 1e6));
 
-  // --quick: dx = 0.04 m (25 x 50); --full: CASES.md dx = 0.02 m and the refinement 0.01 m.
+  // --quick: dx = 0.04 m (25 x 50); --full: docs/cases.md dx = 0.02 m and the refinement 0.01 m.
   const double dx = opt.full ? 0.02 : 0.04;
-  // --quick ends at 5 % axial strain to fit CI; --full runs to CASES.md's 8 %.
+  // --quick ends at 5 % axial strain to fit CI; --full runs to docs/cases.md's 8 %.
   const double end_strain = opt.full ? 0.08 : 0.05;
   const std::vector<double> snaps = opt.full ? std::vector<double>{0.03, 0.05, 0.08} : std::vector<double>{0.03, 0.05};
   SampleResult r = run_sample(case_file, dx, end_strain, snaps, q_y);
@@ -238,7 +238,7 @@ CaseReport validate_case03(const Options& opt, const std::string& dir) {
   }
   rep.notes.push_back(fmt::format("resolution dx = {} m ({}), {} steps, RK4 sub-steps max {}; q and p' are those of "
                                   "the volume-averaged nodal stress tensor",
-                                  dx, opt.full ? "CASES.md" : "quick mode; --full runs CASES.md's 0.02 m and 0.01 m",
+                                  dx, opt.full ? "docs/cases.md" : "quick mode; --full runs docs/cases.md's 0.02 m and 0.01 m",
                                   r.steps, r.max_substeps));
 
   rep.metrics.push_back(metric("CoV of q over particles when average q = 0.9 q_y", r.cov_at_09, "<=", 0.03, ""));
@@ -261,7 +261,7 @@ CaseReport validate_case03(const Options& opt, const std::string& dir) {
   rep.metrics.push_back(metric("band: lower arm angle", r.band_angle_lower, "", 0, "deg"));
   rep.metrics.push_back(metric("band: whole-cloud principal axis angle", r.band_angle_whole, "", 0, "deg"));
   rep.notes.push_back(r.pair ? "the band is a conjugate pair from the imperfection; its angle is the mean of the two arms' "
-                               "principal axes (CASES.md §1.3 applied arm by arm)"
+                               "principal axes (docs/cases.md §1.3 applied arm by arm)"
                              : "the band is a single band; its angle is the principal axis of the thresholded cloud");
   rep.metrics.push_back(metric("distance of the band axis from the imperfection centre", r.band_offset, "", 0, "m"));
   rep.metrics.push_back(metric("particles in the band (eps >= 50 % max)", r.band_particles, "", 0, ""));

@@ -1,4 +1,4 @@
-// Thesis case 4: elastic vertical cut (CASES.md Case 4). (a) the group's set-up, gravity ramp
+// Thesis case 4: elastic vertical cut (docs/cases.md Case 4). (a) the group's set-up, gravity ramp
 // with damping, against the FE reference points, the exact section equilibrium and the
 // traction-free faces; (b) the exactly solvable variant (nu = 0, smooth base, sudden gravity)
 // against its closed form over two periods.
@@ -25,7 +25,7 @@ constexpr double kGammaH = kRho * kG * kH;  // rho g H = 196.2 kPa
 struct RefPoint {
   double x, y, sxx, syy, sxy;  // kPa
 };
-// CASES.md Case 4(a): 9-node FE reference (kPa).
+// docs/cases.md Case 4(a): 9-node FE reference (kPa).
 constexpr RefPoint kRefPoints[] = {
     {0.0, 5.0, -19.3, -101.2, 0.0}, {5.0, 5.0, -11.8, -102.3, -1.6}, {9.9, 5.0, 0.0, -76.9, -0.6},
     {0.0, 1.0, -68.0, -175.0, 0.0}, {5.0, 1.0, -62.6, -175.3, 14.4},
@@ -49,7 +49,7 @@ struct CaseA {
 };
 
 CaseA run_a(const std::string& file, double dx, const std::string& dir, std::vector<std::string>& notes) {
-  // CASES.md's dt = 1e-3 s is a Courant number of 0.46 at dx = 0.5 m; finer spacings keep it.
+  // docs/cases.md's dt = 1e-3 s is a Courant number of 0.46 at dx = 0.5 m; finer spacings keep it.
   std::vector<std::string> over = {fmt::format("geometry.spacing={}", dx), "output.interval=0"};
   if (dx < 0.25 - 1e-12) over.push_back(fmt::format("time.dt={}", 1e-3 * dx / 0.5));
   const CutRun r = run_cut(file, over, 0.01);
@@ -74,7 +74,7 @@ CaseA run_a(const std::string& file, double dx, const std::string& dir, std::vec
       pts << fmt::format("{},{},{},{},{:.4f}\n", p.x, p.y, names[k], ref[k], c[k]);
     }
   }
-  // Displacements (CASES.md): settlements at the top, outward face displacement.
+  // Displacements (docs/cases.md): settlements at the top, outward face displacement.
   struct Disp {
     const char* name;
     double x, y, ref;
@@ -91,7 +91,7 @@ CaseA run_a(const std::string& file, double dx, const std::string& dir, std::vec
     a.disp_err = std::max(a.disp_err, std::abs(v - d.ref) / d.ref);
     dsp << fmt::format("{},{},{:.6g}\n", d.name, d.ref, v);
   }
-  // Drift of the crest after the relaxation (METHOD.md §0.3 item 8: the steady flow at the toe).
+  // Drift of the crest after the relaxation (method-notes §0.3 item 8: the steady flow at the toe).
   for (std::size_t k = 0; k < r.t.size(); ++k) {
     if (r.t[k] >= 1.2 - 1e-9) {
       a.crest_err_relaxed = std::abs(r.uc[k] - 1.76e-3) / 1.76e-3;
@@ -148,7 +148,7 @@ CaseA run_a(const std::string& file, double dx, const std::string& dir, std::vec
   return a;
 }
 
-// Closed forms of CASES.md Case 4(b), u_y positive up (the top settles: negative).
+// Closed forms of docs/cases.md Case 4(b), u_y positive up (the top settles: negative).
 double exact_base_stress(double t) {
   const double c = std::sqrt(kE / kRho), T = 4.0 * kH / c;
   const double tau = std::fmod(t, T);
@@ -243,12 +243,12 @@ CaseReport validate_case04(const Options& opt, const std::string& dir) {
   CaseReport rep;
   rep.id = "04";
   rep.title = "Elastic vertical cut (V1)";
-  rep.reference = "CASES.md Case 4: (a) 9-node FE reference points and exact equilibrium checks; "
+  rep.reference = "docs/cases.md Case 4: (a) 9-node FE reference points and exact equilibrium checks; "
                   "(b) closed form of the nu = 0 block under sudden gravity";
   const std::string file_a = (fs::path(opt.cases_dir) / "04a_elastic_cut_2d.toml").string();
   const std::string file_b = (fs::path(opt.cases_dir) / "04b_elastic_cut_closed_form_2d.toml").string();
 
-  // (a) at CASES.md's dx = 0.5 m and the repeat at 0.25 m (both cheap: run in both modes); full
+  // (a) at docs/cases.md's dx = 0.5 m and the repeat at 0.25 m (both cheap: run in both modes); full
   // mode adds 0.125 m with every figure reported only (the refinement study of the toe corner).
   const std::vector<double> spacings_a = opt.full ? std::vector<double>{0.5, 0.25, 0.125} : std::vector<double>{0.5, 0.25};
   for (double dx : spacings_a) {
@@ -261,7 +261,7 @@ CaseReport validate_case04(const Options& opt, const std::string& dir) {
     if (!disp.pass() && a.crest_err_relaxed <= 0.05) {
       disp.known_deviation = fmt::format(
           "the crest u_x does not stay put: after the relaxation it drifts at {:.2g} m/s, driven by the steady flow at "
-          "the toe (METHOD.md §0.3 item 8, a forced nodal checkerboard whose kinetic energy scales as 1/eps^2 with the "
+          "the toe (method-notes §0.3 item 8, a forced nodal checkerboard whose kinetic energy scales as 1/eps^2 with the "
           "filter strength); at t = 1.2 s, just relaxed, its error is {:.1f} %, inside 5 %",
           a.crest_drift, 100.0 * a.crest_err_relaxed);
     }
@@ -277,7 +277,7 @@ CaseReport validate_case04(const Options& opt, const std::string& dir) {
           "elastic stress field is singular at that corner (Williams exponent lambda - 1 = -0.289 for a clamped-free "
           "right angle at nu = 0.3, scripts/williams_corner.py; it does not fall with refinement: 9.0 % at dx = 0.5 m, "
           "10.7 % at 0.25 m), so no extrapolation from the stress points vanishes there, and the steady toe flow of "
-          "METHOD.md §0.3 item 8 lives in those rows; for y >= 0.1 H it is "
+          "method-notes §0.3 item 8 lives in those rows; for y >= 0.1 H it is "
           "{:.2g} %, inside 2 %", 100.0 * a.face_res_above);
     }
     rep.metrics.push_back(face);
@@ -291,7 +291,7 @@ CaseReport validate_case04(const Options& opt, const std::string& dir) {
                                  0.0, ""));
     rep.metrics.push_back(metric(tag + "traction residual on the top (stress points extrapolated) / rho g H",
                                  a.top_res, "<=", 0.02, ""));
-    rep.metrics.push_back(metric(tag + "kinetic energy at t = 2 s / its peak (METHOD.md §0.3 item 8)",
+    rep.metrics.push_back(metric(tag + "kinetic energy at t = 2 s / its peak (method-notes §0.3 item 8)",
                                  a.ke_peak > 0 ? a.ke_end / a.ke_peak : NAN, "", 0.0, ""));
     rep.notes.push_back(fmt::format("(a) dx = {} m: {} steps, {:.1f} s; at t = 2 s kinetic energy {:.3g} J/m (peak "
                                     "{:.3g}), largest |v| = {:.3g} m/s at ({}, {}) m",
@@ -315,7 +315,7 @@ CaseReport validate_case04(const Options& opt, const std::string& dir) {
     }
   }
   rep.notes.push_back("(a) particles do not move in V1, so the tensile-instability clumping at the top corner "
-                      "cannot occur (METHOD.md §0.3 item 6); the stress at the crest node is in a_final_dx*.csv");
+                      "cannot occur (method-notes §0.3 item 6); the stress at the crest node is in a_final_dx*.csv");
 
   // (b) over two periods at 0.5, 0.25 and the acceptance resolution 0.125 m.
   for (double dx : {0.5, 0.25, 0.125}) {

@@ -1,5 +1,5 @@
-// Thesis case 5: viscoplastic vertical cut without softening (CASES.md Case 5): N = 3.4 must
-// stand and N = 4.2 collapse (CASES.md §1.3 classification), and the failure surface of the
+// Thesis case 5: viscoplastic vertical cut without softening (docs/cases.md Case 5): N = 3.4 must
+// stand and N = 4.2 collapse (docs/cases.md §1.3 classification), and the failure surface of the
 // collapse must pass by the toe and emerge on the top 0.7H-1.15H behind the crest.
 #include <cmath>
 #include <filesystem>
@@ -33,7 +33,7 @@ CaseReport validate_case05(const Options& opt, const std::string& dir) {
   CaseReport rep;
   rep.id = "05";
   rep.title = "Viscoplastic vertical cut without softening (V1)";
-  rep.reference = "CASES.md Case 5: limit analysis of a vertical cut in a Tresca material, N_c = gamma H/c ~ 3.78 "
+  rep.reference = "docs/cases.md Case 5: limit analysis of a vertical cut in a Tresca material, N_c = gamma H/c ~ 3.78 "
                   "(bracket 2.83-4.00); circular mechanism emerging 0.91H behind the crest";
   const std::string file = (fs::path(opt.cases_dir) / "05_viscoplastic_cut_2d.toml").string();
   const std::vector<double> spacings = opt.full ? std::vector<double>{0.25, 0.125} : std::vector<double>{0.5};
@@ -66,7 +66,7 @@ CaseReport validate_case05(const Options& opt, const std::string& dir) {
       std::ofstream(fs::path(dir) / "meta.csv") << "dx,H,W,emergence\n" << fmt::format("{},{},{},{}\n", dx, kH, kW, emerge);
     }
   }
-  if (!opt.full) rep.notes.push_back("quick mode: dx = 0.5 m; --full runs CASES.md's 0.25 m and the refinement 0.125 m");
+  if (!opt.full) rep.notes.push_back("quick mode: dx = 0.5 m; --full runs docs/cases.md's 0.25 m and the refinement 0.125 m");
   if (opt.plots) {
     std::string note;
     if (run_plot_script("plot_case05.py", dir, note)) {

@@ -1,4 +1,4 @@
-// Thesis case 6: viscoplastic vertical cut with softening (CASES.md Case 6): N0 = 2.2 must stand
+// Thesis case 6: viscoplastic vertical cut with softening (docs/cases.md Case 6): N0 = 2.2 must stand
 // and N0 = 3.9 collapse at both resolutions; the band is narrower than the plastic zone of
 // case 5 at N = 4.2, its width at mid-height changes by less than 25 % when dx is halved, and
 // it starts at the toe.
@@ -18,7 +18,7 @@ namespace fs = std::filesystem;
 namespace {
 constexpr double kH = 10.0, kW = 20.0, kGamma = 2000.0 * 9.81;
 
-// The --set overrides of a softening run at N0 = gamma H / c0 (CASES.md Case 6).
+// The --set overrides of a softening run at N0 = gamma H / c0 (docs/cases.md Case 6).
 std::vector<std::string> strength(double n0, double dx) {
   const double c0 = kGamma * kH / n0, y0 = std::sqrt(3.0) * c0;
   return {fmt::format("geometry.spacing={}", dx), "output.interval=0", fmt::format("material.cohesion={:.6g}", c0),
@@ -42,7 +42,7 @@ CaseReport validate_case06(const Options& opt, const std::string& dir) {
   CaseReport rep;
   rep.id = "06";
   rep.title = "Viscoplastic vertical cut with softening (V1)";
-  rep.reference = "CASES.md Case 6: strength between residual and peak: N0 = 2.2 must stand (residual limit "
+  rep.reference = "docs/cases.md Case 6: strength between residual and peak: N0 = 2.2 must stand (residual limit "
                   "2.27), N0 = 3.9 must collapse (peak limit 3.78); band-width objectivity";
   const std::string file = (fs::path(opt.cases_dir) / "06_softening_cut_2d.toml").string();
   const std::string file5 = (fs::path(opt.cases_dir) / "05_viscoplastic_cut_2d.toml").string();
@@ -95,7 +95,7 @@ CaseReport validate_case06(const Options& opt, const std::string& dir) {
                                  std::abs(widths[1] - widths[0]) / widths[0], "<=", 0.25, ""));
   }
   if (!opt.full) {
-    rep.notes.push_back("quick mode: the three runs at dx = 0.5 m and N0 = 3.9 also at 0.25 m; --full runs CASES.md's "
+    rep.notes.push_back("quick mode: the three runs at dx = 0.5 m and N0 = 3.9 also at 0.25 m; --full runs docs/cases.md's "
                         "0.25 m and 0.125 m");
   }
   if (opt.plots) {

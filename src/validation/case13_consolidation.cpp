@@ -1,4 +1,4 @@
-// Thesis case 13: consolidation of a saturated soil column (CASES.md Case 13, V3 solver),
+// Thesis case 13: consolidation of a saturated soil column (docs/cases.md Case 13, V3 solver),
 // against Terzaghi's series with Biot's c_v, convolved exactly with the 0.5 s load ramp.
 #include <algorithm>
 #include <chrono>
@@ -110,7 +110,7 @@ ColumnRun run_column(const std::string& case_file, double dx) {
       for (std::size_t k = 0; k < nn; ++k) {
         prof[k] = pw(k) / p0;
         const double r = ref.pressure(out.depth[k], t) / p0;
-        // CASES.md: at T_v = 0.05 the two particle rows next to the drained top are excluded.
+        // docs/cases.md: at T_v = 0.05 the two particle rows next to the drained top are excluded.
         if (!(next == 0 && out.depth[k] < 2.5 * dx)) einf = std::max(einf, std::abs(prof[k] - r));
         out.e2_num += (prof[k] - r) * (prof[k] - r);
         out.e2_den += r * r;
@@ -174,7 +174,7 @@ CaseReport validate_case13(const Options& opt, const std::string& dir) {
   rep.id = "13";
   rep.title = "Consolidation of a saturated soil column (V3)";
   rep.reference = "Terzaghi series with Biot's c_v = 3.089 m^2/s and p0 = q Q/(M+Q) = 4.545 kPa "
-                  "(CASES.md Case 13), convolved exactly with the 0.5 s load ramp "
+                  "(docs/cases.md Case 13), convolved exactly with the 0.5 s load ramp "
                   "(src/validation/analytic_saturated.hpp)";
   const std::string case_file = (fs::path(opt.cases_dir) / "13_consolidation_column.toml").string();
   const analytic::Terzaghi ref{column13(), kQ, kRamp};

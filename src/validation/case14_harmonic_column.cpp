@@ -1,4 +1,4 @@
-// Thesis case 14: harmonic loading of a saturated soil column (CASES.md Case 14, V3 solver),
+// Thesis case 14: harmonic loading of a saturated soil column (docs/cases.md Case 14, V3 solver),
 // against the exact steady-state u-p_w solution for several dimensionless permeabilities.
 #include <algorithm>
 #include <chrono>
@@ -44,7 +44,7 @@ struct HarmonicRun {
   double iterations_mean = 0.0, pressure_share = 0.0, seconds = 0.0;
 };
 
-// Run length: at least 10 periods (CASES.md) and 5 time constants of the first consolidation
+// Run length: at least 10 periods (docs/cases.md) and 5 time constants of the first consolidation
 // mode, tau_1 = 4 L^2/(pi^2 c_v) = 13 s. A sine load starting at t = 0 leaves a slowly decaying
 // mean (DC) pore pressure of about q0/(omega tau_1) in that mode; after 10 periods of T = 2 s it
 // still biases max|p_w| by 0.7 % q0 at every dx. Near resonance (T = 0.1 s) the beating
@@ -137,7 +137,7 @@ CaseReport validate_case14(const Options& opt, const std::string& dir) {
   CaseReport rep;
   rep.id = "14";
   rep.title = "Harmonic loading of a saturated soil column (V3)";
-  rep.reference = "exact steady-state u-p_w solution of CASES.md Case 14 (4x4 complex system, "
+  rep.reference = "exact steady-state u-p_w solution of docs/cases.md Case 14 (4x4 complex system, "
                   "src/validation/analytic_saturated.hpp); envelope max|p_w| over the last 2 periods";
   const std::string case_file = (fs::path(opt.cases_dir) / "14_harmonic_loading_column.toml").string();
   const std::vector<double> periods = {0.5, 2.0, 10.0};
@@ -166,7 +166,7 @@ CaseReport validate_case14(const Options& opt, const std::string& dir) {
     }
   }
   {
-    // Optional, informative (CASES.md): T = 0.1 s, near the first resonance; peak 4.20 q0.
+    // Optional, informative (docs/cases.md): T = 0.1 s, near the first resonance; peak 4.20 q0.
     const HarmonicRun r = run_harmonic(case_file, 0.1, 0.1);
     write_run(dir, r);
     rep.metrics.push_back(metric("T = 0.1 s (optional), dx = 0.1: relative error of the peak envelope (exact 4.203 q0)",

@@ -1,6 +1,6 @@
-// Thesis case 15: strip foundation on saturated soil (CASES.md Case 15, V3 solver, 2D): the
+// Thesis case 15: strip foundation on saturated soil (docs/cases.md Case 15, V3 solver, 2D): the
 // undrained response (k = 1e-5 m/s, time average over 0.5-1.5 s) against the plane-strain FE
-// table of CASES.md, and the drained end state (k = 1e-3 m/s, t = 130 s) against the drained
+// table of docs/cases.md, and the drained end state (k = 1e-3 m/s, t = 130 s) against the drained
 // settlements.
 //
 //
@@ -8,7 +8,7 @@
 // displacements follow the stress points' velocity (docs/method-notes.md, "Displacements"):
 // the edge no longer runs away. What is left in the drained run is a small steady pore
 // pressure fed by the O(dt) nodal velocity that the two-step scheme keeps at a load jump in a
-// steady state (METHOD.md §2.4 takes div v* at the nodes); see docs/VALIDATION.md, Case 15.
+// steady state (method-notes §2.4 takes div v* at the nodes); see docs/VALIDATION.md, Case 15.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -35,7 +35,7 @@ struct Point {
   const char* name;
   double x, depth, ref, tol;
 };
-// CASES.md Case 15, undrained p_w / sigma0 and the tolerance of each point.
+// docs/cases.md Case 15, undrained p_w / sigma0 and the tolerance of each point.
 const std::vector<Point> kPoints = {{"(0, 1 m)", 0.0, 1.0, 0.748, 0.15},
                                     {"(0, 2 m)", 0.0, 2.0, 0.605, 0.10},
                                     {"(0, 5 m)", 0.0, 5.0, 0.388, 0.10},
@@ -75,7 +75,7 @@ CaseReport validate_case15(const Options& opt, const std::string& dir) {
   CaseReport rep;
   rep.id = "15";
   rep.title = "Strip foundation on saturated soil (V3, 2D)";
-  rep.reference = "CASES.md Case 15: plane-strain FE undrained table (time average 0.5-1.5 s of the k = 1e-5 m/s "
+  rep.reference = "docs/cases.md Case 15: plane-strain FE undrained table (time average 0.5-1.5 s of the k = 1e-5 m/s "
                   "run) and drained end-state settlements";
   const std::string case_file = (fs::path(opt.cases_dir) / "15_strip_foundation_saturated.toml").string();
   // Quick: 0.25 m, a lattice with a node on the footing edge (x = 3 m), which then takes half
@@ -203,7 +203,7 @@ CaseReport validate_case15(const Options& opt, const std::string& dir) {
                                     dx, sc, se, nodes.size(), ps->mean_iterations(), ps->max_iterations,
                                     100.0 * pressure_stage(solver, "case 15").seconds() / seconds, seconds));
   }
-  if (!opt.full) rep.notes.push_back("quick mode: dx = 0.25 m; --full runs dx = 0.2 m (CASES.md)");
+  if (!opt.full) rep.notes.push_back("quick mode: dx = 0.25 m; --full runs dx = 0.2 m (docs/cases.md)");
   return rep;
 }
 

@@ -1,4 +1,4 @@
-// Thesis case 16: strain localisation in a saturated Cam-Clay sample (CASES.md Case 16, V3):
+// Thesis case 16: strain localisation in a saturated Cam-Clay sample (docs/cases.md Case 16, V3):
 // the undrained elastic stage and first yield against their closed forms, the undrained
 // critical-state end point (k = 1e-9 m/s, no band), and the band with water drawn into it
 // (k = 1e-6 m/s). The sample, platens and material are those of case 3.
@@ -23,7 +23,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// CASES.md Case 16 (case-3 material and loading, saturated).
+// docs/cases.md Case 16 (case-3 material and loading, saturated).
 constexpr double kE = 2.0e7, kNu = 0.3, kM = 1.2, kP0 = 5.0e4, kPc0 = 4.0e5;
 constexpr double kLambda = 0.20, kKappa = 0.02, kE0 = 1.0;
 constexpr double kPorosity = 0.4, kKf = 2.2e9;
@@ -32,8 +32,8 @@ constexpr double kHeight = kSampleHeight, kWidth = kSampleWidth;
 // the first-yield axial strain): the sample's response leaves the elastic path there.
 constexpr double kYieldEps = 1.0e-4;
 
-/// Closed forms of CASES.md Case 16. Elasticity of our Cam-Clay is constant E and nu
-/// (src/materials, docs/materials.md), so the constant-K end point of CASES.md applies.
+/// Closed forms of docs/cases.md Case 16. Elasticity of our Cam-Clay is constant E and nu
+/// (src/materials, docs/materials.md), so the constant-K end point of docs/cases.md applies.
 /// s = sigma_1 - sigma_3 (total, compression positive); the lateral total stress is constant.
 struct Undrained {
   double K = kE / (3.0 * (1.0 - 2.0 * kNu));
@@ -224,7 +224,7 @@ SatRun run_sample(const std::string& case_file, double dx, double k, double end_
     out.cov_eps_interior = cov(0.1 + 1e-9);
     out.band = fit_band(s.x, s.y, s.eps, kHeight, 0.1, 0.04, 1.0);
     // p_w in the band cloud against the zone around it: the nodes outside the cloud within
-    // 0.2 m (about twice the band width of CASES.md) of a cloud node, off the platen margins.
+    // 0.2 m (about twice the band width of docs/cases.md) of a cloud node, off the platen margins.
     // The seed: nodes of a material other than the sample's (the most common one).
     std::vector<std::size_t> per_material;
     for (std::size_t i = 0; i < nn; ++i) {
@@ -300,7 +300,7 @@ CaseReport validate_case16(const Options& opt, const std::string& dir) {
   CaseReport rep;
   rep.id = "16";
   rep.title = "Saturated Cam-Clay plane-strain compression, strain localisation (V3)";
-  rep.reference = "closed forms of CASES.md Case 16 (constant M, constant E and nu): undrained elastic stage "
+  rep.reference = "closed forms of docs/cases.md Case 16 (constant M, constant E and nu): undrained elastic stage "
                   "dp_w = B(1+nu_u)s/3 and q = s sqrt(1-nu_u+nu_u^2), first yield q_y = 159.1 kPa, undrained "
                   "critical state p'_f = 183.0 kPa, q_f = 219.6 kPa; band-angle bounds 43-68 deg";
   const std::string case_file = (fs::path(opt.cases_dir) / "16_saturated_cam_clay_localisation_2d.toml").string();
@@ -325,7 +325,7 @@ CaseReport validate_case16(const Options& opt, const std::string& dir) {
       "(constant-K elasticity: our Cam-Clay has constant E and nu, docs/materials.md)",
       u.B, u.nu_u, u.Eu / 1e6, s_y / 1e3, q_y / 1e3, u.p(s_y) / 1e3, pw_y / 1e3, 100 * eps_y, p_f / 1e3, q_f / 1e3));
 
-  // --quick: dx = 0.04 m (25 x 50); --full: CASES.md's dx = 0.02 m. Both run to 8 %.
+  // --quick: dx = 0.04 m (25 x 50); --full: docs/cases.md's dx = 0.02 m. Both run to 8 %.
   const double dx = opt.full ? 0.02 : 0.04;
   const std::vector<double> snaps = {0.03, 0.05, 0.08};
   const SatRun und = run_sample(case_file, dx, 1e-9, 0.08, snaps, u);
@@ -394,7 +394,7 @@ CaseReport validate_case16(const Options& opt, const std::string& dir) {
       m.known_deviation = fmt::format(
           "the cloud above 50 % of the maximum eps_vp_eq is {} particles, the imperfection zone itself (as in the quick "
           "run of case 3): at this resolution the bands (a conjugate pair from the imperfection, see the maps) carry "
-          "less than half the imperfection's strain, so CASES.md §1.3's threshold does not see them",
+          "less than half the imperfection's strain, so docs/cases.md §1.3's threshold does not see them",
           loc.band.particles);
     }
     rep.metrics.push_back(m);
@@ -440,7 +440,7 @@ CaseReport validate_case16(const Options& opt, const std::string& dir) {
   rep.notes.push_back("checkerboard measure: the fourth difference |f_(i-2) - 4 f_(i-1) + 6 f_i - 4 f_(i+1) + f_(i+2)|/16 "
                       "along x and y (exact amplitude of a node-to-node alternation, zero for any cubic field), largest "
                       "over the nodes whose stencils fit in the sample, divided by max |p_w|");
-  if (!opt.full) rep.notes.push_back("quick mode: dx = 0.04 m; --full runs CASES.md's 0.02 m");
+  if (!opt.full) rep.notes.push_back("quick mode: dx = 0.04 m; --full runs docs/cases.md's 0.02 m");
   std::string note;
   if (opt.plots && run_plot_script("plot_case16.py", dir, note)) {
     rep.plots = {"case16/response.png", "case16/maps.png"};

@@ -1,4 +1,4 @@
-// Thesis case 17: saturated vertical cut (CASES.md Case 17, V3): the Tresca limit with
+// Thesis case 17: saturated vertical cut (docs/cases.md Case 17, V3): the Tresca limit with
 // gamma_sat, independent of the permeability. N = 3.4 must stand and N = 4.2 collapse for
 // k = 1e-5 and 1e-7 m/s; the crest displacement of the stable runs must not depend much on k;
 // the mechanism emerges 0.7H-1.15H behind the crest; the fast gravity ramp is undrained, so at
@@ -68,7 +68,7 @@ SatCut run_saturated_cut(const std::string& file, double dx, double n_stab, doub
   SatCut r;
   r.n_stab = n_stab;
   r.k = k;
-  const double c = n_stab < 3.78 ? 57710.0 : 46710.0;  // Pa, CASES.md Case 17 (gamma_sat H / N)
+  const double c = n_stab < 3.78 ? 57710.0 : 46710.0;  // Pa, docs/cases.md Case 17 (gamma_sat H / N)
   const std::vector<std::string> set = {fmt::format("geometry.spacing={}", dx), "output.interval=0",
                                         fmt::format("material.cohesion={:.6g}", c),
                                         fmt::format("fluid.conductivity={:g}", k)};
@@ -133,7 +133,7 @@ CaseReport validate_case17(const Options& opt, const std::string& dir) {
   CaseReport rep;
   rep.id = "17";
   rep.title = "Saturated vertical cut (V3)";
-  rep.reference = "CASES.md Case 17: limit analysis of a vertical cut in a Tresca material with gamma_sat, N_c = "
+  rep.reference = "docs/cases.md Case 17: limit analysis of a vertical cut in a Tresca material with gamma_sat, N_c = "
                   "gamma_sat H/c ~ 3.78 (bracket 2.83-4.00), independent of k; circular mechanism emerging 0.91H behind "
                   "the crest; undrained ramp: p_w = mean total stress";
   const std::string file = (fs::path(opt.cases_dir) / "17_saturated_vertical_cut_2d.toml").string();
@@ -196,7 +196,7 @@ CaseReport validate_case17(const Options& opt, const std::string& dir) {
   rep.notes.push_back("checkerboard measure: the fourth difference |f_(i-2) - 4 f_(i-1) + 6 f_i - 4 f_(i+1) + f_(i+2)|/16 "
                       "along x and y (exact amplitude of a node-to-node alternation, zero for any cubic field) over the "
                       "non-drained nodes, divided by max |p_w|");
-  if (!opt.full) rep.notes.push_back("quick mode: dx = 0.5 m; --full runs CASES.md's 0.25 m");
+  if (!opt.full) rep.notes.push_back("quick mode: dx = 0.5 m; --full runs docs/cases.md's 0.25 m");
   if (opt.plots) {
     std::string note;
     if (run_plot_script("plot_case17.py", dir, note)) {

@@ -1,7 +1,7 @@
 #pragma once
-// Shared by the vertical-cut validation cases 4-6 (CASES.md Cases 4, 5, 6): running a cut case
+// Shared by the vertical-cut validation cases 4-6 (docs/cases.md Cases 4, 5, 6): running a cut case
 // with histories of the crest displacement and the kinetic energy, the stable / collapse
-// classification of CASES.md §1.3, and measures of the plastic-strain field.
+// classification of docs/cases.md §1.3, and measures of the plastic-strain field.
 #include <functional>
 #include <string>
 #include <vector>
@@ -10,7 +10,7 @@
 
 namespace rktsph::validation {
 
-/// CASES.md §1.3: the outcome of a limit-state run.
+/// docs/cases.md §1.3: the outcome of a limit-state run.
 enum class CutOutcome { stable, collapse, undecided };
 const char* outcome_name(CutOutcome o);
 
@@ -23,7 +23,7 @@ struct Classification {
 };
 
 /// Classify a run from its histories (time t, crest displacement u_c outward positive, kinetic
-/// energy ke, all sampled alike) for a cut of height H (CASES.md §1.3):
+/// energy ke, all sampled alike) for a cut of height H (docs/cases.md §1.3):
 ///  stable   if over the last `window` seconds u_c changes by less than 1e-3 H and the
 ///           kinetic energy stays two orders of magnitude below its peak;
 ///  collapse if u_c > 0.05 H, or if u_c is still accelerating at the end (its increment over
@@ -45,7 +45,7 @@ struct CutRun {
   CutSnapshot final_state;
   CutSnapshot onset;                   // when u_c first exceeded the onset threshold (if it did)
   bool has_onset = false;
-  /// When u_c first exceeded the collapse threshold 0.05 H (CASES.md §1.3), if it did: fields
+  /// When u_c first exceeded the collapse threshold 0.05 H (docs/cases.md §1.3), if it did: fields
   /// of different runs compared at the same crest displacement.
   CutSnapshot at_collapse;
   bool has_collapse_state = false;
@@ -55,8 +55,8 @@ struct CutRun {
   long max_substeps = 0;
   double seconds = 0.0;
   std::string error;                   // non-empty if the solver stopped (non-finite state)
-  /// Traction residuals at the end: the stress-point (element) stresses extrapolated linearly
-  /// from the two element columns (rows) next to the face x = W (the top y = H), largest
+  /// Traction residuals at the end: the stress points' stresses extrapolated linearly
+  /// from the two stress-point columns (rows) next to the face x = W (the top y = H), largest
   /// |sigma_xx|, |sigma_xy| on the face (|sigma_yy|, |sigma_xy| on the top), Pa. The nodal
   /// values there are prescribed and exact by construction; these are what the body carries.
   double face_residual = 0.0, top_residual = 0.0;
@@ -105,7 +105,7 @@ void row_profile(const CutSnapshot& s, const std::vector<double>& field, double 
                  std::vector<double>& xs, std::vector<double>& fs);
 
 /// Smallest distance from the point (px, py) to a node where eps >= 0.5 max(eps) (the band
-/// cloud of CASES.md §1.3), with the maximum taken over nodes with y >= ymin.
+/// cloud of docs/cases.md §1.3), with the maximum taken over nodes with y >= ymin.
 double band_distance_to(const CutSnapshot& s, double px, double py, double ymin);
 
 /// Emergence of the failure surface on the top, m behind the crest: position of the largest

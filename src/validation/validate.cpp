@@ -71,7 +71,7 @@ int run_validation(const Options& opt) {
 
   std::ofstream md(fs::path(opt.out_dir) / "report.md");
   md << fmt::format("# rktsph validation report\n\nrktsph {} ({}), mode: {}.\n\n", kVersion, kGitRevision,
-                    opt.full ? "full (CASES.md resolutions)" : "quick (coarse resolutions for CI)");
+                    opt.full ? "full (docs/cases.md resolutions)" : "quick (coarse resolutions for CI)");
   md << "| case | status | run time |\n|---|---|---|\n";
   int failed = 0;
   for (const auto& r : reports) {

@@ -1,5 +1,5 @@
 #pragma once
-// `rktsph validate`: run the thesis cases, compare them with their references (CASES.md) by
+// `rktsph validate`: run the thesis cases, compare them with their references (docs/cases.md) by
 // code in this repository, write a report with plots, and fail if a criterion is not met.
 #include <functional>
 #include <string>
@@ -61,7 +61,7 @@ struct CaseReport {
 };
 
 struct Options {
-  bool full = false;             // CASES.md resolutions (else coarse, CI-sized)
+  bool full = false;             // docs/cases.md resolutions (else coarse, CI-sized)
   std::string out_dir = "validation";
   std::string cases_dir;         // where cases/thesis lives
   std::vector<std::string> only;  // case ids; empty = all

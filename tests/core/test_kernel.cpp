@@ -1,4 +1,4 @@
-// Cubic B-spline kernel (METHOD.md §3.1): normalisation, derivative, support, gradient.
+// Cubic B-spline kernel (method-notes §3.1): normalisation, derivative, support, gradient.
 #include <gtest/gtest.h>
 
 #include <cmath>

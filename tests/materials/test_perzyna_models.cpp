@@ -40,7 +40,7 @@ TEST(VonMisesPerzyna, NoFlowInsideTheSurface) {
 }
 
 TEST(VonMisesPerzyna, CohesionGivesPlaneStrainShearStrength) {
-  // CASES.md §1.2 C2: sigma_Y = sqrt(3) c, so pure shear yields at tau = c.
+  // docs/cases.md §1.2 C2: sigma_Y = sqrt(3) c, so pure shear yields at tau = c.
   auto m = material_from_toml(
       "model = 'perzyna_von_mises'\nE = 1e7\nnu = 0.3\ndensity = 2000\ncohesion = 5e4\n"
       "fluidity = 1.0\n");
@@ -84,7 +84,7 @@ TEST(VonMisesPerzyna, SteadyStateUnderConstantDeviatoricStrainRate) {
 }
 
 // Fixed strain, N = 1, H = 0: q_dot = -3 G gamma (q - Y)/Y, so the overstress decays as
-// exp(-3 G gamma t / Y), the rate quoted in METHOD.md §4.3.
+// exp(-3 G gamma t / Y), the rate quoted in method-notes §4.3.
 TEST(VonMisesPerzyna, StressRelaxationDecaysAtTheMethodRate) {
   auto m = material_from_toml(test::von_mises(1.0));
   const double gamma = 1.0, rate = 3.0 * kG * gamma / kY;  // 115.4 1/s
@@ -242,7 +242,7 @@ TEST(PerzynaSource, FrozenFluxAndAdditiveAgreeToSecondOrder) {
 // ---------------------------------------------------------------------------------------
 // Modified Cam-Clay
 
-// CASES.md Case 3 closed form: plane-strain compression from isotropic p0 with constant
+// docs/cases.md Case 3 closed form: plane-strain compression from isotropic p0 with constant
 // lateral stress; s = sigma_1 - sigma_3 (compression positive).
 struct Case3Closed {
   double nu = 0.3, E = 2.0e7, p0 = 50e3, pc = 400e3;
@@ -280,7 +280,7 @@ YieldPoint first_yield(const PathResult& r, double M) {
 TEST(CamClayPerzyna, Case3ElasticPathAndFirstYield) {
   const Case3Closed cf;
   auto m = material_from_toml(test::kCamClayCase3);
-  LoadPath path = LoadPath::plane_strain_compression(-0.05);  // CASES.md: 0.05 1/s
+  LoadPath path = LoadPath::plane_strain_compression(-0.05);  // docs/cases.md: 0.05 1/s
   path.duration = 0.8;                                        // 4 % axial strain
   path.dt = 2e-4;
   const Sym6 s0{-cf.p0, -cf.p0, -cf.p0, 0, 0, 0};
@@ -295,7 +295,7 @@ TEST(CamClayPerzyna, Case3ElasticPathAndFirstYield) {
   EXPECT_NEAR(inv.p, cf.p0 + (1 + cf.nu) * s / 3, 1e-9 * s);
   EXPECT_NEAR(inv.q, s * std::sqrt(1 - cf.nu + cf.nu * cf.nu), 1e-9 * s);
   EXPECT_EQ(e.state[0], 0.0);
-  // First yield: the closed-form root and the CASES.md numbers.
+  // First yield: the closed-form root and the docs/cases.md numbers.
   const YieldPoint y = first_yield(r, 1.2);
   EXPECT_NEAR(y.s, cf.s_yield(1.2), 1e-6 * y.s);
   EXPECT_NEAR(y.s, 265.9e3, 0.1e3);

@@ -37,7 +37,7 @@ TEST(PerzynaParts, VonMisesValueAndGradientMatchFiniteDifferences) {
   const Sym6 g = vm.gradient(kGeneral, 1.0);
   const Sym6 fd = fd_gradient([&](const Sym6& s) { return vm.value(s, 1.0); }, kGeneral, 1.0);
   for (std::size_t i = 0; i < 6; ++i) EXPECT_NEAR(g[i], fd[i], 1e-7) << "component " << i;
-  // Flow: deviatoric, unit equivalent norm sqrt(2/3 m:m) = 1 (METHOD.md §1.7).
+  // Flow: deviatoric, unit equivalent norm sqrt(2/3 m:m) = 1 (method-notes §1.7).
   const Sym6 m = vm.flow(kGeneral, 1.0);
   EXPECT_NEAR(tensor::trace(m), 0.0, 1e-14);
   EXPECT_NEAR(tensor::equivalent_strain(m), 1.0, 1e-12);
@@ -52,7 +52,7 @@ TEST(PerzynaParts, CamClayValueGradientAndFlowMatchFiniteDifferences) {
     for (std::size_t i = 0; i < 6; ++i) {
       EXPECT_NEAR(g[i], fd[i], 1e-6 * (1.0 + std::abs(fd[i]))) << "lode " << lode << " i " << i;
     }
-    // m = (df/dsigma)/p_c with the ellipse f = q^2 + M(theta)^2 p'(p' - p_c) (METHOD.md §1.8).
+    // m = (df/dsigma)/p_c with the ellipse f = q^2 + M(theta)^2 p'(p' - p_c) (method-notes §1.8).
     auto f = [&](const Sym6& s) {
       const Invariants inv = invariants(s);
       const Sym6 d = tensor::deviator(s);
@@ -100,7 +100,7 @@ TEST(PerzynaParts, CamClayLodeDependentM) {
   EXPECT_NEAR(M_of({-50e3, -150e3, -50e3, 0, 0, 0}), Mc, 1e-12);
   // Triaxial extension: M = 6 sin(phi)/(3 + sin(phi)).
   EXPECT_NEAR(M_of({-150e3, -50e3, -150e3, 0, 0, 0}), 6.0 * sphi / (3.0 + sphi), 1e-12);
-  // CASES.md Case 3: plane-strain elastic path, nu = 0.3, has sin 3theta = 0.629, M = 1.117.
+  // docs/cases.md Case 3: plane-strain elastic path, nu = 0.3, has sin 3theta = 0.629, M = 1.117.
   const double s = 100e3, nu = 0.3, p0 = 50e3;
   EXPECT_NEAR(M_of({-p0, -(p0 + s), -(p0 + nu * s), 0, 0, 0}), 1.117, 5e-4);
   EXPECT_NEAR(CamClaySurface::M_from_friction_angle(30.0), 1.2, 1e-12);

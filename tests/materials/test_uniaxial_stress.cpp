@@ -1,5 +1,5 @@
 // The uniaxial-stress decorator (materials/uniaxial_stress.hpp) against the closed-form 1D
-// Perzyna law of CASES.md Case 2: relaxation at fixed strain and the steady state under a
+// Perzyna law of docs/cases.md Case 2: relaxation at fixed strain and the steady state under a
 // constant strain rate; lateral stresses stay zero.
 #include <gtest/gtest.h>
 
@@ -92,7 +92,7 @@ TEST(UniaxialStress, SteadyStateUnderConstantStrainRate) {
 }
 
 TEST(UniaxialStress, SofteningUsesTheCurrentSize) {
-  // Variant B of CASES.md Case 2: the overstress is normalised by Y(eps), here 0.5 Y0.
+  // Variant B of docs/cases.md Case 2: the overstress is normalised by Y(eps), here 0.5 Y0.
   const auto m = wrapped(2.0, "hardening_modulus = -2.0e5\n");
   double k[1] = {0.25};  // Y = 1e5 - 2e5 * 0.25 = 0.5e5
   Sym6 ds;

@@ -1,4 +1,4 @@
-// Linear-exact corrected operators between the staggered sets (METHOD.md §3.2, §0.3 item 2):
+// Linear-exact corrected operators between the staggered sets (method-notes §3.2, §0.3 item 2):
 // interpolation and gradient reproduce constants and linear fields exactly at every target,
 // including truncated supports at edges and corners and on jittered particle sets; a quadratic
 // field is not reproduced, which shows the checks can fail.
@@ -102,18 +102,18 @@ TEST_P(Operator1D, ExactForConstantAndLinearBothDirections) {
   auto zero = [](const Vec<1>&) { return Vec<1>(0.0); };
   auto glin = [](const Vec<1>&) { return Vec<1>(1.7); };
   for (const auto* op : {&en, &ne}) {
-    const bool to_elements = op == &en;
-    const auto& targets = to_elements ? disc.stress_points.position : disc.nodes.position;
-    const auto& sources = to_elements ? disc.nodes : disc.stress_points;
+    const bool to_stress_points = op == &en;
+    const auto& targets = to_stress_points ? disc.stress_points.position : disc.nodes.position;
+    const auto& sources = to_stress_points ? disc.nodes : disc.stress_points;
     const auto ec = apply_errors<1>(*op, targets, sources, c, zero, scale);
     const auto el = apply_errors<1>(*op, targets, sources, lin, glin, scale);
     EXPECT_LT(ec.interp, kTol);
     EXPECT_LT(ec.grad, kTol);
     EXPECT_LT(el.interp, kTol);
     EXPECT_LT(el.grad, kTol);
-    RecordProperty(to_elements ? "linear_grad_err_en" : "linear_grad_err_ne", fmt::format("{:.3g}", el.grad));
+    RecordProperty(to_stress_points ? "linear_grad_err_en" : "linear_grad_err_ne", fmt::format("{:.3g}", el.grad));
   }
-  // The end node x = 0 has only elements on one side (truncated support): check it alone.
+  // The end node x = 0 has only stress points on one side (truncated support): check it alone.
   const auto end = apply_errors<1>(ne, disc.nodes.position, disc.stress_points, lin, glin, scale,
                                    [&](const Vec<1>& x) { return x[0] < 0.5 * dx || x[0] > L - 0.5 * dx; });
   EXPECT_LT(end.interp, kTol);
@@ -146,9 +146,9 @@ TEST_P(Operator2D, ExactForConstantAndLinearBothDirections) {
   auto glin = [](const Vec<2>&) { return Vec<2>(-0.8, 2.3); };
   double worst = 0.0;
   for (const auto* op : {&en, &ne}) {
-    const bool to_elements = op == &en;
-    const auto& targets = to_elements ? disc.stress_points.position : disc.nodes.position;
-    const auto& sources = to_elements ? disc.nodes : disc.stress_points;
+    const bool to_stress_points = op == &en;
+    const auto& targets = to_stress_points ? disc.stress_points.position : disc.nodes.position;
+    const auto& sources = to_stress_points ? disc.nodes : disc.stress_points;
     const auto ec = apply_errors<2>(*op, targets, sources, c, zero, scale);
     const auto el = apply_errors<2>(*op, targets, sources, lin, glin, scale);
     EXPECT_LT(ec.interp, kTol);
@@ -234,7 +234,7 @@ TEST(CorrectedOperator, QuadraticIsNotReproducedButErrorIsSmall) {
   RecordProperty("quadratic_grad_err_jittered", fmt::format("{:.3g}", e.grad));
 }
 
-// ---- difference-form gradient (fix (a) of METHOD.md §0.3) ----
+// ---- difference-form gradient (fix (a) of method-notes §0.3) ----
 
 TEST(DifferenceGradient, ExactForLinearFieldWithExactFhat) {
   const double dx = 0.5, lx = 3.0, ly = 2.0;

@@ -1,4 +1,4 @@
-// Schwaiger-corrected node Laplacian (METHOD.md §3.5, §6 item 7): exact for linear fields on
+// Schwaiger-corrected node Laplacian (method-notes §3.5, §6 item 7): exact for linear fields on
 // irregular and truncated particle sets (edges and corners included), within 1 % for a
 // quadratic field in the interior, symmetric part symmetric with zero row sums, and the
 // impermeable-wall rows reproduce the even extension of a field with zero normal derivative.
@@ -93,7 +93,7 @@ TEST(Laplacian, QuadraticWithinOnePercentInTheInterior) {
       worst = std::max(worst, std::abs(Lf[i] - 4.0) / 4.0);
     }
     EXPECT_LT(worst, 0.01) << "jitter " << jitter;
-    // Edges stay bounded (METHOD.md §3.5 table: the corrected form is O(1) wrong there, not
+    // Edges stay bounded (method-notes §3.5 table: the corrected form is O(1) wrong there, not
     // O(1/dx)).
     EXPECT_LT(Lf.cwiseAbs().maxCoeff(), 40.0);
   }
@@ -161,7 +161,7 @@ TEST(Laplacian, MirrorWallsRestoreTheFullSupportIn2D) {
     worst_plain = std::max(worst_plain, std::abs(Pf[i] - 4.0) / 4.0);
   }
   EXPECT_LT(worst, 0.01);
-  EXPECT_GT(worst_plain, 0.1);  // without the mirrors the wall rows are far off (METHOD.md §3.5)
+  EXPECT_GT(worst_plain, 0.1);  // without the mirrors the wall rows are far off (method-notes §3.5)
   // The symmetric part stays symmetric with the images.
   const Eigen::SparseMatrix<double> S = lap.symmetric;
   EXPECT_LT((S - Eigen::SparseMatrix<double>(S.transpose())).norm(), 1e-12 * S.norm());

@@ -1,5 +1,5 @@
 // generate_lattice(): nodes at lattice vertices with tributary volumes, stress points at cell centres,
-// boundary face flags and face areas (METHOD.md §3.3).
+// boundary face flags and face areas (method-notes §3.3).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -45,12 +45,12 @@ TEST(Discretise, CountsAndTotalVolumesOfAnLShape) {
   EXPECT_NEAR(vn, 12.0, 1e-12);
   EXPECT_NEAR(ve, 12.0, 1e-12);
   for (double v : d.stress_points.volume) EXPECT_DOUBLE_EQ(v, dx * dx);
-  // Elements sit at cell centres, strictly inside the body.
+  // Stress points sit at cell centres, strictly inside the body.
   for (const auto& x : d.stress_points.position) {
     const double fx = x[0] / dx - std::floor(x[0] / dx), fy = x[1] / dx - std::floor(x[1] / dx);
     EXPECT_NEAR(fx, 0.5, 1e-12);
     EXPECT_NEAR(fy, 0.5, 1e-12);
-    EXPECT_FALSE(x[0] > 2.0 && x[1] > 2.0) << "element in the missing quadrant";
+    EXPECT_FALSE(x[0] > 2.0 && x[1] > 2.0) << "stress point in the missing quadrant";
   }
   // Mass: each set carries the whole mass.
   double mn = 0.0, me = 0.0;

@@ -1,5 +1,5 @@
 // The nodal velocity checkerboard is a zero-energy mode of the staggered scheme in 2D
-// (METHOD.md §0.3 item 3): the elements, at the cell centres, see a zero interpolated value
+// (method-notes §0.3 item 3): the stress points, at the cell centres, see a zero interpolated value
 // and zero gradient of it. Without the velocity filter it survives; with it, it is removed.
 #include <gtest/gtest.h>
 
@@ -73,7 +73,7 @@ double run_checkerboard(bool filter, int steps) {
   }
   const double a0 = checkerboard_amplitude(solver);
   EXPECT_NEAR(a0, kAmplitude, 1e-15);
-  // Sanity: the elements cannot see the mode (their interpolated velocity is ~0 after step 1).
+  // Sanity: the stress points cannot see the mode (their interpolated velocity is ~0 after step 1).
   solver.step();
   double emax = 0.0;
   for (Index e = 0; e < solver.stress_points().size(); ++e) {

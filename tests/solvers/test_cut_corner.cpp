@@ -1,4 +1,4 @@
-// Boundary closure of a cut (METHOD.md §0.3 item 8) and the damped equilibrium:
+// Boundary closure of a cut (method-notes §0.3 item 8) and the damped equilibrium:
 //  - at the toe, where a fixed base meets a free face, the face tractions sigma_xx and sigma_xy
 //    are held at zero while sigma_yy (the base reaction) is free; at the corner of a roller side
 //    and a free top, sigma_xy = 0;

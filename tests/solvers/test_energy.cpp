@@ -1,5 +1,5 @@
 // Energy balance of the V1 solver: kinetic + strain - external work (+ damping loss) stays
-// near zero on the 1D bar under a smooth load (METHOD.md §0.3 item 2: 0.7 % at N = 100) and
+// near zero on the 1D bar under a smooth load (method-notes §0.3 item 2: 0.7 % at N = 100) and
 // on an undamped 2D block under a gravity ramp.
 #include <gtest/gtest.h>
 

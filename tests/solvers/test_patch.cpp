@@ -1,4 +1,4 @@
-// Patch test of the V1 solver (METHOD.md §0.3 items 1-2): a uniform stress state with the
+// Patch test of the V1 solver (method-notes §0.3 items 1-2): a uniform stress state with the
 // matching tractions prescribed on every face is an exact steady state of the discrete
 // scheme; it must persist to round-off over many steps, in 1D and 2D.
 #include <gtest/gtest.h>

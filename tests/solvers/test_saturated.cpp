@@ -1,4 +1,4 @@
-// V3 saturated solver (METHOD.md §2.4, §5.3; CASES.md C4): the pressure matrix is symmetric
+// V3 saturated solver (method-notes §2.4, §5.3; docs/cases.md C4): the pressure matrix is symmetric
 // positive definite with a Dirichlet row, the PCG reaches the requested tolerance with both
 // preconditioners, the undrained limit (k -> 0) gives p0 = q Q/(M+Q) and the undrained
 // settlement, the time step is the drained skeleton's, and the drained limit (k -> infinity)
@@ -103,7 +103,7 @@ TEST(PorePressure, ConjugateGradientReachesTheRequestedTolerance) {
   }
 }
 
-// The 1D column of CASES.md Case 13 (H = 10 m unless given), as a V3 case.
+// The 1D column of docs/cases.md Case 13 (H = 10 m unless given), as a V3 case.
 std::string column(double H, double dx, double conductivity, const std::string& load, double end,
                    const std::string& top_pressure = "pore_pressure = 0.0",
                    const std::string& base_pressure = "impermeable = true") {
@@ -150,7 +150,7 @@ cfl = 0.5
 constexpr double kM = 3.0e7 * 0.8 / (1.2 * 0.6), kQ = 1.0e8 / 0.3, kRho = 1700.0;
 
 // k = 0 and no drained face: the load, a total stress on the (impermeable) top, is carried by
-// the pore pressure p0 = q Q/(M+Q) and the skeleton q M/(M+Q) (CASES.md Case 13). (A drained
+// the pore pressure p0 = q Q/(M+Q) and the skeleton q M/(M+Q) (docs/cases.md Case 13). (A drained
 // top with k = 0 is singular: p jumps from p0 to 0 there, and the scheme spreads the jump
 // over a few dx.) Means over 2-3 s (after a 2 s load ramp) remove the free vibration.
 struct UndrainedColumn {
@@ -348,7 +348,7 @@ cfl = 0.5
 // stress, -gamma (H - y), and keep it while the weight is held. The non-incremental projection
 // imposes dp/dn = 0 at the walls on the stabilisation (dt/rho) L p as well, while the load needs
 // dp/dy = -gamma Q/(M+Q) there: the mismatch leaks pore pressure through the "impermeable" base
-// whatever k is (CASES.md Case 17 showed it). The incremental variant (solver.pressure_incremental)
+// whatever k is (docs/cases.md Case 17 showed it). The incremental variant (solver.pressure_incremental)
 // puts the stabilisation on p^{n+1} - p^n only and removes most of the leak; what is left
 // (base p_w 0.97 -> 0.94 of the undrained value from 1 to 3 s at dx = 0.2 m, against 0.81 ->
 // 0.66 non-incremental) is not explained yet.
@@ -425,7 +425,7 @@ cfl = 0.5
 TEST(Saturated, IncrementalProjectionReducesTheUndrainedPressureLeakUnderGravity) {
   const double p_ref = kQ / (kM + kQ) * kRho * 9.81 * 4.0;  // undrained p_w at the base
   const auto inc = undrained_strip_base_pressure(true);
-  const auto non = undrained_strip_base_pressure(false);  // the METHOD.md §2.4 default
+  const auto non = undrained_strip_base_pressure(false);  // the non-incremental form, method-notes §2.4
   for (double p : inc) EXPECT_NEAR(p, p_ref, 0.07 * p_ref);
   // Over the hold (1 -> 3 s) the incremental variant loses about a fifth of what the
   // non-incremental one loses (measured: 3.1 % against 14.8 % of the reference).
@@ -509,7 +509,7 @@ TEST(Saturated, PressureFilterDampsTheCheckerboardThatTheIncrementalProjectionKe
   // it exerts no force and nothing but the pressure equation's stabilisation can remove it.
   const double incremental = checkerboard_left_after(true, 0.0, 20);
   const double filtered = checkerboard_left_after(true, 1.0, 20);
-  const double projection = checkerboard_left_after(false, 0.0, 20);  // METHOD.md §2.4
+  const double projection = checkerboard_left_after(false, 0.0, 20);  // method-notes §2.4
   EXPECT_GT(incremental, 0.5);
   EXPECT_LT(filtered, 0.01);
   EXPECT_LT(projection, 0.01);

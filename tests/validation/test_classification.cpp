@@ -1,4 +1,4 @@
-// The stable / collapse classification of CASES.md §1.3 (validation/cut_common.hpp) is not
+// The stable / collapse classification of docs/cases.md §1.3 (validation/cut_common.hpp) is not
 // trivially true: synthetic histories of each kind are told apart, and on a coarse case-5 cut
 // the full strength at N = 3.4 stands while half the cohesion (N = 6.8) collapses.
 #include <gtest/gtest.h>
