@@ -13,8 +13,8 @@
 #include <fmt/format.h>
 
 #include "case/case_builder.hpp"
-#include "operators/corrected_operator.hpp"
 #include "linear_solvers/pore_pressure.hpp"
+#include "operators/corrected_operator.hpp"
 #include "schemes/pressure_stage.hpp"
 #include "schemes/simulation.hpp"
 
@@ -125,8 +125,14 @@ void BM_V1Step(benchmark::State& state) {
   state.counters["GB/s"] = benchmark::Counter(traffic * steps / 1e9, benchmark::Counter::kIsRate);
   state.counters["of_triad"] = g_triad_gbs > 0.0 ? traffic * steps / seconds / 1e9 / g_triad_gbs : 0.0;
 }
-BENCHMARK(BM_V1Step)->Args({10000, 1})->Args({100000, 1})->Args({100000, 2})->Args({1000000, 1})
-    ->Args({1000000, 2})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_V1Step)
+    ->Args({10000, 1})
+    ->Args({100000, 1})
+    ->Args({100000, 2})
+    ->Args({1000000, 1})
+    ->Args({1000000, 2})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 // The V3 (saturated) step on the same block with a drained top: the explicit V1 part plus the
 // pore-pressure step (right-hand side, PCG solve with the Jacobi preconditioner, velocity
@@ -160,8 +166,13 @@ void BM_V3Step(benchmark::State& state) {
   state.counters["threads"] = static_cast<double>(state.range(1));
   state.counters["filter"] = static_cast<double>(state.range(2));
 }
-BENCHMARK(BM_V3Step)->Args({10000, 1, 1})->Args({10000, 1, 0})->Args({100000, 1, 1})->Args({100000, 2, 1})
-    ->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_V3Step)
+    ->Args({10000, 1, 1})
+    ->Args({10000, 1, 0})
+    ->Args({100000, 1, 1})
+    ->Args({100000, 2, 1})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 // Neighbour search (cell list) and corrected-operator assembly of both directions, one thread:
 // the set-up the large-deformation version would repeat every step.

@@ -5,13 +5,13 @@
 #include <string>
 #include <vector>
 
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
+#include <CLI/CLI.hpp>
 
 #include "app/material_point.hpp"
 #include "app/run_case.hpp"
-#include "core/error.hpp"
 #include "case/material_reader.hpp"
+#include "core/error.hpp"
 #include "rktsph/version.hpp"
 #include "validation/validation.hpp"
 
@@ -41,8 +41,8 @@ int main(int argc, char** argv) {
 
   std::string mp_file, mp_out;
   std::vector<std::string> mp_overrides;
-  auto* mp_cmd = app.add_subcommand(
-      "material-point", "Drive one material point along a stress/strain path (path.csv + plot)");
+  auto* mp_cmd =
+      app.add_subcommand("material-point", "Drive one material point along a stress/strain path (path.csv + plot)");
   mp_cmd->add_option("case", mp_file, "Material-point file (TOML)")->required()->check(CLI::ExistingFile);
   mp_cmd->add_option("--out,-o", mp_out, "Output folder (default: out/<file name>)");
   mp_cmd->add_option("--set,-s", mp_overrides, "Override a key, e.g. --set material.fluidity=10");
@@ -52,8 +52,8 @@ int main(int argc, char** argv) {
   validation::Options val;
   val.cases_dir = std::string(RKTSPH_SOURCE_DIR) + "/cases/thesis";
   bool val_quick = false;
-  auto* val_cmd = app.add_subcommand(
-      "validate", "Run the thesis cases against their references; write validation/report.md");
+  auto* val_cmd =
+      app.add_subcommand("validate", "Run the thesis cases against their references; write validation/report.md");
   val_cmd->add_option("cases", val.only, "Case numbers to run, e.g. 01 (default: all)");
   auto* full_flag = val_cmd->add_flag("--full", val.full, "docs/cases.md acceptance resolutions");
   val_cmd->add_flag("--quick", val_quick, "Coarse resolutions that fit in CI (default)")->excludes(full_flag);

@@ -22,10 +22,11 @@ void write_path_csv(const std::string& file, const Material& material, const Pat
   out << '\n';
   for (const PathPoint& pt : r.points) {
     const Invariants inv = invariants(pt.stress);
-    out << fmt::format("{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},"
-                       "{:.10g},{:.10g}",
-                       pt.t, pt.strain[0], pt.strain[1], pt.strain[2], pt.strain[3], pt.stress[0],
-                       pt.stress[1], pt.stress[2], pt.stress[3], inv.p, inv.q);
+    out << fmt::format(
+        "{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},"
+        "{:.10g},{:.10g}",
+        pt.t, pt.strain[0], pt.strain[1], pt.strain[2], pt.strain[3], pt.stress[0], pt.stress[1], pt.stress[2],
+        pt.stress[3], inv.p, inv.q);
     for (double v : pt.state) out << fmt::format(",{:.10g}", v);
     out << '\n';
   }
@@ -55,20 +56,20 @@ int run_material_point(const std::string& case_file, const std::string& out_dir,
       j["final"][c.material->state_names()[i]] = last.state[i];
     }
     std::ofstream(std::filesystem::path(out_dir) / "summary.json") << j.dump(2) << '\n';
-    fmt::print("material point: {} along {}: {} steps, {} RK4 sub-steps; final p = {:.6g} Pa, "
-               "q = {:.6g} Pa\nwrote {}\n",
-               c.material->model(), c.path_type, r.steps, r.substeps, inv.p, inv.q, csv);
+    fmt::print(
+        "material point: {} along {}: {} steps, {} RK4 sub-steps; final p = {:.6g} Pa, "
+        "q = {:.6g} Pa\nwrote {}\n",
+        c.material->model(), c.path_type, r.steps, r.substeps, inv.p, inv.q, csv);
     if (c.plot) {
       const std::string script = std::string(RKTSPH_SOURCE_DIR) + "/scripts/plot_material_point.py";
-      const bool have_mpl =
-          std::filesystem::exists("/usr/bin/python3") &&
-          std::system("/usr/bin/python3 -c 'import matplotlib' >/dev/null 2>&1") == 0;
+      const bool have_mpl = std::filesystem::exists("/usr/bin/python3") &&
+                            std::system("/usr/bin/python3 -c 'import matplotlib' >/dev/null 2>&1") == 0;
       if (!have_mpl) {
         fmt::print("note: /usr/bin/python3 with matplotlib not found; no plot written\n");
       } else {
         const std::string png = (std::filesystem::path(out_dir) / "path.png").string();
-        const std::string cmd = fmt::format("/usr/bin/python3 '{}' '{}' '{}' --strain {}", script,
-                                            csv, png, c.plot_strain);
+        const std::string cmd =
+            fmt::format("/usr/bin/python3 '{}' '{}' '{}' --strain {}", script, csv, png, c.plot_strain);
         if (std::system(cmd.c_str()) != 0) {
           fmt::print("note: the plot script failed; path.csv is complete\n");
         } else {

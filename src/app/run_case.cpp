@@ -56,8 +56,7 @@ int run_dim(const RunOptions& opt, const CaseDocument& doc) {
   fs::create_directories(out / "vtu");
   {
     std::ofstream resolved(out / "case.resolved.toml");
-    resolved << "# resolved input of " << opt.case_file << " (rktsph " << kVersion << ", "
-             << kGitRevision << ")\n"
+    resolved << "# resolved input of " << opt.case_file << " (rktsph " << kVersion << ", " << kGitRevision << ")\n"
              << doc.table << "\n";
   }
 
@@ -88,9 +87,10 @@ int run_dim(const RunOptions& opt, const CaseDocument& doc) {
       }
     }
     if (best_d > 0.5 * std::sqrt(static_cast<double>(Dim)) * setup.dx + 1e-9) {
-      throw InputError(fmt::format("{}: probe '{}' at [{}] lies outside the body (nearest node "
-                                   "is {:.4g} m away)",
-                                   spec.where, spec.name, fmt::join(spec.position, ", "), best_d));
+      throw InputError(
+          fmt::format("{}: probe '{}' at [{}] lies outside the body (nearest node "
+                      "is {:.4g} m away)",
+                      spec.where, spec.name, fmt::join(spec.position, ", "), best_d));
     }
     Probe p{spec.name, best, {}};
     for (const auto& f : spec.fields) {
@@ -122,9 +122,8 @@ int run_dim(const RunOptions& opt, const CaseDocument& doc) {
   energy_csv << "t,kinetic,strain,external_work,damping_loss,imbalance\n";
   auto record_energy = [&] {
     const EnergyBalance e = solver.energy();
-    energy_csv << fmt::format("{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g}\n", solver.time(),
-                              e.kinetic, e.strain - e.initial_strain, e.external_work,
-                              e.damping_loss, e.imbalance());
+    energy_csv << fmt::format("{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g}\n", solver.time(), e.kinetic,
+                              e.strain - e.initial_strain, e.external_work, e.damping_loss, e.imbalance());
   };
 
   io::PvdCollection node_pvd((out / "nodes.pvd").string());
@@ -165,9 +164,10 @@ int run_dim(const RunOptions& opt, const CaseDocument& doc) {
           solver.cfl() * PorePressureStage<Dim>::kUndrainedCourantLimit / pressure->undrained_courant());
     }
     if (solver.degenerate_operator_rows() > 0) {
-      std::cerr << fmt::format("warning: {} particles have too few neighbours for the corrected "
-                               "operator and use plain SPH sums\n",
-                               solver.degenerate_operator_rows());
+      std::cerr << fmt::format(
+          "warning: {} particles have too few neighbours for the corrected "
+          "operator and use plain SPH sums\n",
+          solver.degenerate_operator_rows());
     }
   }
 
@@ -206,9 +206,8 @@ int run_dim(const RunOptions& opt, const CaseDocument& doc) {
           last_progress = now;
           const double elapsed = std::chrono::duration<double>(now - t_loop).count();
           const double eta = elapsed * static_cast<double>(total_steps - n - 1) / static_cast<double>(n + 1);
-          std::cerr << fmt::format("\r  t = {:.5g} s of {:.5g} s ({:3.0f} %), step {} of {}, ETA {}   ",
-                                   t, setup.end_time, 100.0 * t / setup.end_time, n + 1,
-                                   total_steps, duration_text(eta))
+          std::cerr << fmt::format("\r  t = {:.5g} s of {:.5g} s ({:3.0f} %), step {} of {}, ETA {}   ", t,
+                                   setup.end_time, 100.0 * t / setup.end_time, n + 1, total_steps, duration_text(eta))
                     << std::flush;
         }
       }
@@ -256,9 +255,12 @@ int run_dim(const RunOptions& opt, const CaseDocument& doc) {
       {"bytes_operators", solver.operator_bytes()},
       {"bytes_per_node", static_cast<double>(solver.state_bytes() + solver.operator_bytes()) / nodes_count},
       {"max_source_substeps", solver.max_source_substeps()},
-      {"energy", {{"kinetic", e.kinetic}, {"strain", e.strain - e.initial_strain},
-                  {"external_work", e.external_work}, {"damping_loss", e.damping_loss},
-                  {"imbalance", e.imbalance()}}},
+      {"energy",
+       {{"kinetic", e.kinetic},
+        {"strain", e.strain - e.initial_strain},
+        {"external_work", e.external_work},
+        {"damping_loss", e.damping_loss},
+        {"imbalance", e.imbalance()}}},
       {"output_frames", frame},
   };
   // Damping switched off by the kinetic-energy test (damping.until_kinetic_ratio), or null.
@@ -287,18 +289,17 @@ int run_dim(const RunOptions& opt, const CaseDocument& doc) {
   if (!opt.quiet) {
     if (pressure != nullptr) {
       const PressureSolveStats* ps = &pressure->stats();
-      std::cerr << fmt::format("pore pressure: {} PCG solves, iterations mean {:.1f} / max {}, final relative "
-                               "residual {:.2e}; pressure step {:.0f} % of the loop time\n",
-                               ps->solves, ps->mean_iterations(), ps->max_iterations, ps->last_error,
-                               loop_seconds > 0 ? 100.0 * pressure->seconds() / loop_seconds : 0.0);
+      std::cerr << fmt::format(
+          "pore pressure: {} PCG solves, iterations mean {:.1f} / max {}, final relative "
+          "residual {:.2e}; pressure step {:.0f} % of the loop time\n",
+          ps->solves, ps->mean_iterations(), ps->max_iterations, ps->last_error,
+          loop_seconds > 0 ? 100.0 * pressure->seconds() / loop_seconds : 0.0);
     }
     if (exit_code == 0) {
-      std::cerr << fmt::format("done: {} steps in {:.2f} s ({:.3g} node-steps/s); output in {}\n",
-                               solver.step_count(), loop_seconds,
-                               loop_seconds > 0 ? node_steps / loop_seconds : 0.0, out.string());
+      std::cerr << fmt::format("done: {} steps in {:.2f} s ({:.3g} node-steps/s); output in {}\n", solver.step_count(),
+                               loop_seconds, loop_seconds > 0 ? node_steps / loop_seconds : 0.0, out.string());
     } else {
-      std::cerr << fmt::format("error: {}\nthe output up to the last good step is kept in {}\n",
-                               message, out.string());
+      std::cerr << fmt::format("error: {}\nthe output up to the last good step is kept in {}\n", message, out.string());
     }
   }
   return exit_code;

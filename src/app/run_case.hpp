@@ -8,8 +8,8 @@ struct RunOptions {
   std::string case_file;
   std::string out_dir;  // empty: out/<case name>
   std::vector<std::string> overrides;
-  int threads = 0;       // 0: OpenMP default
-  bool quiet = false;    // no progress line
+  int threads = 0;     // 0: OpenMP default
+  bool quiet = false;  // no progress line
 };
 
 /// Run a case end to end and write its output folder. Returns the exit status:

@@ -54,8 +54,8 @@ void NodalConstraints<Dim>::resolve(const std::vector<BoundarySpec<Dim>>& specs,
       const auto tu = static_cast<std::size_t>(t);
       if (t == normal_axis || !region.bounded[tu] || region.hi[tu] - region.lo[tu] <= tol) continue;
       double lo = x[t] - 0.5 * dx, hi = x[t] + 0.5 * dx;
-      if ((faces >> (2 * t)) & 1u) lo = x[t];       // the body ends on the -e_t side
-      if ((faces >> (2 * t + 1)) & 1u) hi = x[t];   // ... on the +e_t side
+      if ((faces >> (2 * t)) & 1u) lo = x[t];      // the body ends on the -e_t side
+      if ((faces >> (2 * t + 1)) & 1u) hi = x[t];  // ... on the +e_t side
       if (hi - lo <= tol) continue;
       const double covered = std::min(hi, region.hi[tu]) - std::max(lo, region.lo[tu]);
       fraction *= std::clamp(covered / (hi - lo), 0.0, 1.0);
@@ -76,7 +76,8 @@ void NodalConstraints<Dim>::resolve(const std::vector<BoundarySpec<Dim>>& specs,
       for (const auto& [axis, value] : spec.velocity) {
         set(i, {axis, value, spec.function}, 1.0);
         for (int d = 0; d < Dim; ++d) {
-          if ((planes >> d) & 1u) velocity_on_face[i] = static_cast<std::uint16_t>(velocity_on_face[i] | (1u << (axis * Dim + d)));
+          if ((planes >> d) & 1u)
+            velocity_on_face[i] = static_cast<std::uint16_t>(velocity_on_face[i] | (1u << (axis * Dim + d)));
         }
       }
       // A traction on a plane (one face) is averaged over the node's face segment; a box
@@ -86,9 +87,10 @@ void NodalConstraints<Dim>::resolve(const std::vector<BoundarySpec<Dim>>& specs,
       for (const auto& [s, value] : spec.stress) set(i, {Dim + s, covered * value, spec.function}, covered);
     }
     if (selected == 0) {
-      throw InputError(fmt::format("{}: boundary '{}' selects no node; check its ranges "
-                                   "against the geometry",
-                                   spec.where, spec.name));
+      throw InputError(
+          fmt::format("{}: boundary '{}' selects no node; check its ranges "
+                      "against the geometry",
+                      spec.where, spec.name));
     }
   }
 
@@ -121,8 +123,7 @@ void NodalConstraints<Dim>::resolve(const std::vector<BoundarySpec<Dim>>& specs,
       if ((faces & (3u << (2 * d))) == 0) continue;
       for (int k = 0; k < Dim; ++k) {
         const int comp = Dim + stress_slot<Dim>(k, d);
-        auto it = std::find_if(list.begin(), list.end(),
-                               [&](const NodalConstraint& c) { return c.component == comp; });
+        auto it = std::find_if(list.begin(), list.end(), [&](const NodalConstraint& c) { return c.component == comp; });
         if ((reaction >> stress_slot<Dim>(k, d)) & 1u) {
           if (it != list.end()) list.erase(it);
         } else if (it == list.end()) {

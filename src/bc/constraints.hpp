@@ -41,7 +41,8 @@ class NodalConstraints {
   /// Position of node i in constrained(), or -1.
   Index constrained_row(Index i) const { return constrained_row_[static_cast<std::size_t>(i)]; }
   std::size_t bytes() const {
-    return row_.size() * sizeof(Index) + list_.size() * sizeof(NodalConstraint) + constrained_row_.size() * sizeof(Index);
+    return row_.size() * sizeof(Index) + list_.size() * sizeof(NodalConstraint) +
+           constrained_row_.size() * sizeof(Index);
   }
 
  private:

@@ -46,8 +46,8 @@ PorePressureConditions resolve_pore_pressure_conditions(const std::vector<Bounda
     }
   }
   if (pc.planes.size() > 8) {
-    throw InputError(fmt::format("{}: the pore-pressure walls lie on {} planes; at most 8 are supported", file,
-                                 pc.planes.size()));
+    throw InputError(
+        fmt::format("{}: the pore-pressure walls lie on {} planes; at most 8 are supported", file, pc.planes.size()));
   }
 
   // Which planes each node mirrors across: the face node nearest to the node's foot on the
@@ -94,10 +94,10 @@ PorePressureConditions resolve_pore_pressure_conditions(const std::vector<Bounda
   return pc;
 }
 
-#define RKTSPH_INSTANTIATE(D)                                                                                   \
-  template PorePressureConditions resolve_pore_pressure_conditions<D>(                                         \
-      const std::vector<BoundarySpec<D>>&, const ParticleSet<D>&, const BoundaryNodes<D>&, double, double, \
-      const std::string&);
+#define RKTSPH_INSTANTIATE(D)                                                                                         \
+  template PorePressureConditions resolve_pore_pressure_conditions<D>(const std::vector<BoundarySpec<D>>&,            \
+                                                                      const ParticleSet<D>&, const BoundaryNodes<D>&, \
+                                                                      double, double, const std::string&);
 RKTSPH_INSTANTIATE(1)
 RKTSPH_INSTANTIATE(2)
 RKTSPH_INSTANTIATE(3)

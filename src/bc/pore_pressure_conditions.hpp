@@ -14,10 +14,10 @@
 namespace rktsph {
 
 struct PorePressureConditions {
-  std::vector<bool> drained;          // per node: p_w prescribed
-  std::vector<double> value;          // prescribed p_w at drained nodes, Pa
-  std::vector<int> function;          // its time function (-1: constant)
-  std::vector<MirrorPlane> planes;    // impermeable wall planes (at most 8)
+  std::vector<bool> drained;              // per node: p_w prescribed
+  std::vector<double> value;              // prescribed p_w at drained nodes, Pa
+  std::vector<int> function;              // its time function (-1: constant)
+  std::vector<MirrorPlane> planes;        // impermeable wall planes (at most 8)
   std::vector<std::uint8_t> mirror_mask;  // per node, bit k: planes[k] mirrors for this node
 };
 

@@ -6,13 +6,14 @@
 
 #include <fmt/format.h>
 
-
 namespace rktsph {
 
 double TimeFunction::operator()(double t) const {
   switch (kind) {
-    case Kind::constant: return value;
-    case Kind::step: return t >= start ? value : 0.0;
+    case Kind::constant:
+      return value;
+    case Kind::step:
+      return t >= start ? value : 0.0;
     case Kind::ramp:
       if (t <= start) return 0.0;
       if (t >= start + duration) return value;
@@ -25,8 +26,7 @@ double TimeFunction::operator()(double t) const {
     case Kind::sine: {
       // method-notes §4.1: a0 + a1 sin(omega t - phi), times a ramp (1 - exp(-t/T)).
       const double ramp = rise_time > 0.0 ? 1.0 - std::exp(-t / rise_time) : 1.0;
-      return value * ramp *
-             (offset + amplitude * std::sin(2.0 * std::numbers::pi * frequency * t - phase));
+      return value * ramp * (offset + amplitude * std::sin(2.0 * std::numbers::pi * frequency * t - phase));
     }
     case Kind::table: {
       if (t <= times.front()) return value * values.front();

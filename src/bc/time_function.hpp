@@ -18,14 +18,14 @@ class TimeFunction {
   static TimeFunction smoothstep(double duration, double start = 0.0);
 
   Kind kind = Kind::constant;
-  double value = 1.0;       // constant level (all kinds scale by it)
-  double start = 0.0;       // s: step and ramp begin here
-  double duration = 0.0;    // s: ramp and smoothstep rise time
-  double offset = 0.0;      // sine: a0
-  double amplitude = 0.0;   // sine: a1
-  double frequency = 0.0;   // sine: Hz
-  double phase = 0.0;       // sine: rad
-  double rise_time = 0.0;   // sine: ramp factor (1 - exp(-t/T)), 0 for none
+  double value = 1.0;                 // constant level (all kinds scale by it)
+  double start = 0.0;                 // s: step and ramp begin here
+  double duration = 0.0;              // s: ramp and smoothstep rise time
+  double offset = 0.0;                // sine: a0
+  double amplitude = 0.0;             // sine: a1
+  double frequency = 0.0;             // sine: Hz
+  double phase = 0.0;                 // sine: rad
+  double rise_time = 0.0;             // sine: ramp factor (1 - exp(-t/T)), 0 for none
   std::vector<double> times, values;  // table: piecewise linear, held constant outside
 };
 

@@ -32,8 +32,7 @@ std::vector<std::string> split(const std::string& s, char sep) {
 void apply_override(toml::table& root, const std::string& assignment) {
   const auto eq = assignment.find('=');
   if (eq == std::string::npos || eq == 0) {
-    throw InputError(fmt::format("--set '{}': expected key=value, e.g. --set material.E=2.5e7",
-                                 assignment));
+    throw InputError(fmt::format("--set '{}': expected key=value, e.g. --set material.E=2.5e7", assignment));
   }
   const std::string key = assignment.substr(0, eq);
   const std::string text = assignment.substr(eq + 1);
@@ -59,12 +58,13 @@ void apply_override(toml::table& root, const std::string& assignment) {
       try {
         idx = std::stoul(p);
       } catch (...) {
-        throw InputError(fmt::format("--set '{}': '{}' indexes an array and must be a number",
-                                     assignment, p));
+        throw InputError(fmt::format("--set '{}': '{}' indexes an array and must be a number", assignment, p));
       }
       if (idx >= a->size()) {
-        throw InputError(fmt::format("--set '{}': index {} is past the end of the array ({} "
-                                     "entries)", assignment, idx, a->size()));
+        throw InputError(
+            fmt::format("--set '{}': index {} is past the end of the array ({} "
+                        "entries)",
+                        assignment, idx, a->size()));
       }
       cur = a->get(idx);
     } else {
@@ -73,8 +73,7 @@ void apply_override(toml::table& root, const std::string& assignment) {
   }
   toml::table* parent = cur->as_table();
   if (parent == nullptr) {
-    throw InputError(fmt::format("--set '{}': the parent of '{}' is not a table", assignment,
-                                 parts.back()));
+    throw InputError(fmt::format("--set '{}': the parent of '{}' is not a table", assignment, parts.back()));
   }
   parent->insert_or_assign(parts.back(), *parsed.get("v"));
 }
@@ -92,8 +91,7 @@ CaseDocument load_case_document(const std::string& file, const std::vector<std::
   try {
     doc.table = toml::parse(buffer.str(), file);
   } catch (const toml::parse_error& e) {
-    throw InputError(fmt::format("{}, line {}: not valid TOML: {}", file,
-                                 e.source().begin.line, e.description()));
+    throw InputError(fmt::format("{}, line {}: not valid TOML: {}", file, e.source().begin.line, e.description()));
   }
   for (const auto& o : overrides) apply_override(doc.table, o);
   return doc;
@@ -135,8 +133,7 @@ TimeFunction read_time_function(const io::Section& s) {
     f.values = s.numbers("values");
     s.require(!f.times.empty(), "times", "needs at least one point");
     s.require(f.times.size() == f.values.size(), "values",
-              fmt::format("must have as many entries as 'times' ({}), got {}", f.times.size(),
-                          f.values.size()));
+              fmt::format("must have as many entries as 'times' ({}), got {}", f.times.size(), f.values.size()));
     for (std::size_t i = 1; i < f.times.size(); ++i) {
       s.require(f.times[i] > f.times[i - 1], "times", "must be strictly increasing");
     }

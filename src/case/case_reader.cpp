@@ -24,8 +24,7 @@ template <int Dim>
 Vec<Dim> read_vector(const io::Section& s, std::string_view key) {
   const auto v = s.numbers(key);
   if (static_cast<int>(v.size()) != Dim) {
-    s.fail(key, fmt::format("must have {} component{} for a {}D case, got {}", Dim,
-                            Dim > 1 ? "s" : "", Dim, v.size()));
+    s.fail(key, fmt::format("must have {} component{} for a {}D case, got {}", Dim, Dim > 1 ? "s" : "", Dim, v.size()));
   }
   Vec<Dim> out;
   for (int d = 0; d < Dim; ++d) out[d] = v[static_cast<std::size_t>(d)];
@@ -54,13 +53,11 @@ int function_index(const CaseSetup<Dim>& c, const io::Section& s, std::string_vi
                                                    : fmt::format("{}", fmt::join(c.function_names, ", "))));
 }
 
-int material_index(const std::vector<std::string>& names, const io::Section& s,
-                   std::string_view key) {
+int material_index(const std::vector<std::string>& names, const io::Section& s, std::string_view key) {
   if (!s.has(key)) {
     s.string(key, "");
     if (names.size() == 1) return 0;
-    s.fail(key, fmt::format("several materials are defined ({}); name the block's material",
-                            fmt::join(names, ", ")));
+    s.fail(key, fmt::format("several materials are defined ({}); name the block's material", fmt::join(names, ", ")));
   }
   const std::string name = s.string(key);
   for (std::size_t i = 0; i < names.size(); ++i) {
@@ -117,14 +114,19 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
       // docs/cases.md §1.1 / Case 2: a 1D bar in uniaxial strain (default) or uniaxial stress.
       const std::string cond = g.string("condition");
       if (Dim != 1) g.fail("condition", "only a 1D case takes a lateral condition (2D is plane strain)");
-      if (cond == "uniaxial_strain") c.condition = BarCondition::uniaxial_strain;
-      else if (cond == "uniaxial_stress") c.condition = BarCondition::uniaxial_stress;
-      else g.fail("condition", fmt::format("unknown condition '{}' (known: uniaxial_strain, uniaxial_stress)", cond));
+      if (cond == "uniaxial_strain")
+        c.condition = BarCondition::uniaxial_strain;
+      else if (cond == "uniaxial_stress")
+        c.condition = BarCondition::uniaxial_stress;
+      else
+        g.fail("condition", fmt::format("unknown condition '{}' (known: uniaxial_strain, uniaxial_stress)", cond));
     } else {
       g.string("condition", "");
     }
-    if (g.has("origin")) c.origin = read_vector<Dim>(g, "origin");
-    else g.number("origin", 0.0);
+    if (g.has("origin"))
+      c.origin = read_vector<Dim>(g, "origin");
+    else
+      g.number("origin", 0.0);
     const auto blocks = g.tables("block");
     if (blocks.empty()) g.fail("block", "missing: the geometry needs at least one [[geometry.block]]");
     for (const io::Section& b : blocks) {
@@ -151,7 +153,8 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     c.h_over_dx = k->positive("h_over_dx", 1.2);
     k->require(c.h_over_dx >= 0.6 && c.h_over_dx <= 3.0, "h_over_dx",
                fmt::format("must lie in [0.6, 3] (a smaller support leaves particles without "
-                           "neighbours), got {}", c.h_over_dx));
+                           "neighbours), got {}",
+                           c.h_over_dx));
     k->finish();
   }
 
@@ -195,15 +198,13 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
       any_axis = true;
     }
     if (!any_axis) {
-      b.fail("", fmt::format("selects no region: give at least one of {} as [min, max]",
-                             Dim == 1 ? "x" : "x, y"));
+      b.fail("", fmt::format("selects no region: give at least one of {} as [min, max]", Dim == 1 ? "x" : "x, y"));
     }
     if (auto v = b.optional_table("velocity")) {
       for (const std::string& axis : v->keys()) {
         const int a = axis_of(axis);
         if (a < 0 || a >= Dim) {
-          v->fail(axis, fmt::format("unknown velocity component (a {}D case has: {})", Dim,
-                                    Dim == 1 ? "x" : "x, y"));
+          v->fail(axis, fmt::format("unknown velocity component (a {}D case has: {})", Dim, Dim == 1 ? "x" : "x, y"));
         }
         spec.velocity.emplace_back(a, v->number(axis));
       }
@@ -227,15 +228,18 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
       st->finish();
     }
     // V3 pore-pressure conditions (checked against solver.version below).
-    if (b.has("pore_pressure")) spec.pore_pressure = b.number("pore_pressure");
-    else b.number("pore_pressure", 0.0);
+    if (b.has("pore_pressure"))
+      spec.pore_pressure = b.number("pore_pressure");
+    else
+      b.number("pore_pressure", 0.0);
     spec.impermeable = b.boolean("impermeable", false);
     if (spec.pore_pressure && spec.impermeable) {
       b.fail("impermeable", "a face is either drained (pore_pressure) or impermeable, not both");
     }
     if (spec.velocity.empty() && spec.stress.empty() && !spec.pore_pressure && !spec.impermeable) {
-      b.fail("", "prescribes nothing: give a velocity = {...} or stress = {...} table (or, with "
-                 "solver.version = \"v3\", pore_pressure or impermeable)");
+      b.fail("",
+             "prescribes nothing: give a velocity = {...} or stress = {...} table (or, with "
+             "solver.version = \"v3\", pore_pressure or impermeable)");
     }
     spec.function = function_index(c, b, "function");
     b.finish();
@@ -256,16 +260,18 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
       } else {
         is->number("K0", 0.0);
       }
-      if (is->has("surface")) c.surface_level = is->number("surface");
-      else is->number("surface", 0.0);
+      if (is->has("surface"))
+        c.surface_level = is->number("surface");
+      else
+        is->number("surface", 0.0);
       if (c.gravity.norm() == 0.0) {
         is->fail("type", "a geostatic initial stress needs [body_force] gravity");
       }
     } else if (type == "uniform") {
       // A uniform initial stress, Pa (tension positive), e.g. an isotropic confinement.
       c.initial_stress = InitialStressKind::uniform;
-      const std::vector<std::string> comps = Dim == 1 ? std::vector<std::string>{"xx", "yy", "zz"}
-                                                      : std::vector<std::string>{"xx", "yy", "zz", "xy"};
+      const std::vector<std::string> comps =
+          Dim == 1 ? std::vector<std::string>{"xx", "yy", "zz"} : std::vector<std::string>{"xx", "yy", "zz", "xy"};
       for (std::size_t i = 0; i < comps.size(); ++i) c.uniform_stress[i == 3 ? 3 : i] = is->number(comps[i], 0.0);
     } else {
       is->fail("type", fmt::format("unknown initial stress '{}' (known: zero, geostatic, uniform)", type));
@@ -311,18 +317,25 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     }
     // V3 pressure solve (method-notes §2.4 "Solver"); read for every version, used by v3 only.
     const std::string pc = s->string("pressure_preconditioner", "jacobi");
-    if (pc == "jacobi") c.fluid.incomplete_cholesky = false;
-    else if (pc == "incomplete_cholesky") c.fluid.incomplete_cholesky = true;
-    else s->fail("pressure_preconditioner", fmt::format("unknown preconditioner '{}' (known: jacobi, incomplete_cholesky)", pc));
+    if (pc == "jacobi")
+      c.fluid.incomplete_cholesky = false;
+    else if (pc == "incomplete_cholesky")
+      c.fluid.incomplete_cholesky = true;
+    else
+      s->fail("pressure_preconditioner",
+              fmt::format("unknown preconditioner '{}' (known: jacobi, incomplete_cholesky)", pc));
     c.fluid.tolerance = s->positive("pressure_tolerance", 1e-8);
     s->require(c.fluid.tolerance < 1e-2, "pressure_tolerance", "must be < 1e-2");
     c.fluid.max_iterations = static_cast<int>(s->integer("pressure_max_iterations", 2000));
     s->require(c.fluid.max_iterations >= 1, "pressure_max_iterations", "must be >= 1");
     c.fluid.deferred_correction = s->boolean("pressure_deferred_correction", true);
     const std::string divergence = s->string("pressure_divergence", "nodes");
-    if (divergence == "nodes") c.fluid.divergence_from_stress_points = false;
-    else if (divergence == "stress_points") c.fluid.divergence_from_stress_points = true;
-    else s->fail("pressure_divergence", fmt::format("unknown value '{}' (known: nodes, stress_points)", divergence));
+    if (divergence == "nodes")
+      c.fluid.divergence_from_stress_points = false;
+    else if (divergence == "stress_points")
+      c.fluid.divergence_from_stress_points = true;
+    else
+      s->fail("pressure_divergence", fmt::format("unknown value '{}' (known: nodes, stress_points)", divergence));
     // The incremental projection is the default with div v* at the nodes. With the stress
     // points' velocity it is unstable (an undrained column blows up within 0.5 s), so there the
     // default is the non-incremental form and asking for both is an error.
@@ -333,17 +346,23 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     s->require(c.fluid.filter >= 0.0 && c.fluid.filter <= 10.0, "pressure_filter",
                fmt::format("must lie in [0, 10] (a multiple of S_w dt/rho), got {}", c.fluid.filter));
     const std::string scheme = s->string("scheme", "staggered");
-    if (scheme == "staggered") c.layout = ParticleLayout::staggered;
-    else if (scheme == "collocated") c.layout = ParticleLayout::collocated;
-    else s->fail("scheme", fmt::format("unknown scheme '{}' (known: staggered, collocated)", scheme));
+    if (scheme == "staggered")
+      c.layout = ParticleLayout::staggered;
+    else if (scheme == "collocated")
+      c.layout = ParticleLayout::collocated;
+    else
+      s->fail("scheme", fmt::format("unknown scheme '{}' (known: staggered, collocated)", scheme));
     c.filter = s->boolean("filter", true);
     c.filter_strength = s->number("filter_strength", 0.5);
     s->require(c.filter_strength > 0.0 && c.filter_strength <= 1.0, "filter_strength",
                fmt::format("must lie in (0, 1], got {}", c.filter_strength));
     const std::string coupling = s->string("source_coupling", "additive");
-    if (coupling == "additive") c.coupling = SourceCoupling::additive;
-    else if (coupling == "frozen_flux") c.coupling = SourceCoupling::frozen_flux;
-    else s->fail("source_coupling", fmt::format("unknown source coupling '{}' (known: additive, frozen_flux)", coupling));
+    if (coupling == "additive")
+      c.coupling = SourceCoupling::additive;
+    else if (coupling == "frozen_flux")
+      c.coupling = SourceCoupling::frozen_flux;
+    else
+      s->fail("source_coupling", fmt::format("unknown source coupling '{}' (known: additive, frozen_flux)", coupling));
     s->finish();
   }
 

@@ -52,7 +52,7 @@ struct BoundarySpec {
   Region<Dim> region;
   std::vector<std::pair<int, double>> velocity;  // (axis, m/s)
   std::vector<std::pair<int, double>> stress;    // (stress slot, Pa)
-  int function = -1;                              // index into CaseSetup::functions, -1 = 1
+  int function = -1;                             // index into CaseSetup::functions, -1 = 1
   // V3 (saturated) pore-pressure conditions, method-notes §4.1: a drained face (p_w prescribed,
   // Pa, scaled by `function`) or an explicitly impermeable one (dp_w/dn = 0, the default).
   std::optional<double> pore_pressure;
@@ -63,17 +63,17 @@ struct BoundarySpec {
 /// "Saturated soil (V3)"). The material `density` is the MIXTURE density
 /// rho = n rho_f + (1 - n) rho_s.
 struct FluidSpec {
-  double porosity = 0.0;                 // n
-  double density = 1000.0;               // rho_f, kg/m^3
-  double bulk_modulus = 0.0;             // K_f, Pa
-  double grain_bulk_modulus = 0.0;       // K_s, Pa; 0 = incompressible grains
-  double conductivity = 0.0;             // k, m/s
-  double gravity = 9.81;                 // g used in k_w = k / (rho_f g), m/s^2
-  double saturation = 1.0;               // S_w
-  double tolerance = 1e-8;               // relative residual of the PCG
+  double porosity = 0.0;            // n
+  double density = 1000.0;          // rho_f, kg/m^3
+  double bulk_modulus = 0.0;        // K_f, Pa
+  double grain_bulk_modulus = 0.0;  // K_s, Pa; 0 = incompressible grains
+  double conductivity = 0.0;        // k, m/s
+  double gravity = 9.81;            // g used in k_w = k / (rho_f g), m/s^2
+  double saturation = 1.0;          // S_w
+  double tolerance = 1e-8;          // relative residual of the PCG
   int max_iterations = 2000;
-  bool incomplete_cholesky = false;      // preconditioner: false = Jacobi (default)
-  bool deferred_correction = true;       // Schwaiger correction on the right-hand side
+  bool incomplete_cholesky = false;  // preconditioner: false = Jacobi (default)
+  bool deferred_correction = true;   // Schwaiger correction on the right-hand side
   /// Incremental pressure projection (method-notes §2.4 "Incremental variant"): the stabilisation
   /// (S_w dt/rho) L acts on p^{n+1} - p^n instead of p^{n+1}.
   bool incremental = true;
@@ -84,10 +84,11 @@ struct FluidSpec {
   /// solver.pressure_filter: coefficient of the linear-exact pressure filter, in units of the
   /// fractional-step stabilisation S_w dt/rho (0 = none; method-notes §2.4).
   double filter = 0.5;
-  double initial_pore_pressure = 0.0;    // Pa, uniform
+  double initial_pore_pressure = 0.0;  // Pa, uniform
   /// 1/Q* = S_w n / K_f + (1 - n)/K_s (method-notes §1.4), 1/Pa
   double inverse_storage() const {
-    return saturation * porosity / bulk_modulus + (grain_bulk_modulus > 0.0 ? (1.0 - porosity) / grain_bulk_modulus : 0.0);
+    return saturation * porosity / bulk_modulus +
+           (grain_bulk_modulus > 0.0 ? (1.0 - porosity) / grain_bulk_modulus : 0.0);
   }
   /// k_w = k / (rho_f g), m^3 s / kg
   double permeability() const { return conductivity / (density * gravity); }
@@ -140,9 +141,9 @@ struct CaseSetup {
 
   // initial state
   InitialStressKind initial_stress = InitialStressKind::zero;
-  std::optional<double> k0;            // geostatic lateral coefficient; default nu/(1-nu)
+  std::optional<double> k0;             // geostatic lateral coefficient; default nu/(1-nu)
   std::optional<double> surface_level;  // geostatic ground surface (vertical axis = last axis)
-  Sym6 uniform_stress{};                 // uniform initial stress (xx, yy, zz, xy, yz, xz), Pa
+  Sym6 uniform_stress{};                // uniform initial stress (xx, yy, zz, xy, yz, xz), Pa
   Vec<Dim> initial_velocity = Vec<Dim>::Zero();
 
   // time
@@ -161,7 +162,7 @@ struct CaseSetup {
   SourceCoupling coupling = SourceCoupling::additive;
 
   // output
-  double output_interval = 0.0;     // s; 0 = first and last state only
+  double output_interval = 0.0;      // s; 0 = first and last state only
   std::vector<double> output_times;  // s; extra snapshots
   bool output_elements = true;
   int probe_every = 1;

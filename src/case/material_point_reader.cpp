@@ -22,8 +22,7 @@ namespace {
 void apply_override(toml::table& root, const std::string& assignment) {
   const auto eq = assignment.find('=');
   if (eq == std::string::npos || eq == 0) {
-    throw InputError(fmt::format("override '{}': expected key=value, e.g. material.E=2.5e7",
-                                 assignment));
+    throw InputError(fmt::format("override '{}': expected key=value, e.g. material.E=2.5e7", assignment));
   }
   const std::string key = assignment.substr(0, eq);
   const std::string text = assignment.substr(eq + 1);
@@ -93,8 +92,7 @@ LoadPath read_path(const io::Section& s, std::string& type, std::string& plot_st
       for (std::size_t i = 0; i < 6; ++i) {
         stress_set[i] = st->has(kStressComponentNames[i]);
         if (stress_set[i] && s.table("strain_rate").has(kStressComponentNames[i])) {
-          st->fail(kStressComponentNames[i],
-                   "a component is either strain- or stress-controlled, not both");
+          st->fail(kStressComponentNames[i], "a component is either strain- or stress-controlled, not both");
         }
       }
       sig = read_sym6(*st);
@@ -125,8 +123,7 @@ LoadPath read_path(const io::Section& s, std::string& type, std::string& plot_st
 
 }  // namespace
 
-MaterialPointCase load_material_point_case(const std::string& case_file,
-                                           const std::vector<std::string>& overrides) {
+MaterialPointCase load_material_point_case(const std::string& case_file, const std::vector<std::string>& overrides) {
   if (!std::filesystem::exists(case_file)) {
     throw InputError(fmt::format("{}: no such case file", case_file));
   }
@@ -134,8 +131,7 @@ MaterialPointCase load_material_point_case(const std::string& case_file,
   try {
     root = toml::parse_file(case_file);
   } catch (const toml::parse_error& e) {
-    throw InputError(fmt::format("{}, line {}: {}", case_file, e.source().begin.line,
-                                 e.description()));
+    throw InputError(fmt::format("{}, line {}: {}", case_file, e.source().begin.line, e.description()));
   }
   for (const std::string& o : overrides) apply_override(root, o);
   const io::Section top(root, "", std::make_shared<const std::string>(case_file));

@@ -90,12 +90,14 @@ std::array<double, N> particle_reduce(const Policy& policy, Index n, ReductionSc
         double acc[N] = {};
         const Index end = std::min(n, (blk + 1) * kReductionBlock);
         for (Index i = blk * kReductionBlock; i < end; ++i) f(i, acc);
-        for (int s = 0; s < N; ++s) block_sums[static_cast<std::size_t>(blk) * N + static_cast<std::size_t>(s)] = acc[s];
+        for (int s = 0; s < N; ++s)
+          block_sums[static_cast<std::size_t>(blk) * N + static_cast<std::size_t>(s)] = acc[s];
       },
       Schedule::even, n);
   std::array<double, N> total{};
   for (Index blk = 0; blk < blocks; ++blk) {
-    for (int s = 0; s < N; ++s) total[static_cast<std::size_t>(s)] += block_sums[static_cast<std::size_t>(blk) * N + static_cast<std::size_t>(s)];
+    for (int s = 0; s < N; ++s)
+      total[static_cast<std::size_t>(s)] += block_sums[static_cast<std::size_t>(blk) * N + static_cast<std::size_t>(s)];
   }
   return total;
 }

@@ -32,8 +32,7 @@ using Sym6 = std::array<double, 6>;
 
 enum class StressComponent : int { xx = 0, yy = 1, zz = 2, xy = 3, yz = 4, xz = 5 };
 
-inline constexpr std::array<std::string_view, 6> kStressComponentNames = {"xx", "yy", "zz",
-                                                                          "xy", "yz", "xz"};
+inline constexpr std::array<std::string_view, 6> kStressComponentNames = {"xx", "yy", "zz", "xy", "yz", "xz"};
 inline constexpr std::array<std::string_view, 3> kAxisNames = {"x", "y", "z"};
 
 /// Index of a 3D Voigt component in the per-dimension stress storage, or -1 if the

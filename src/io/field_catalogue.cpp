@@ -12,8 +12,8 @@ FieldCatalogue<Dim>::FieldCatalogue(const Simulation<Dim>& sim, Set set) {
   auto vector = [&](std::string name, const char* prefix, VectorView<Dim> v) {
     fields_.push_back({std::move(name), 3, [v](Index i, int c) { return c < Dim ? v(i, c) : 0.0; }});
     for (int d = 0; d < Dim; ++d) {
-      scalars_.push_back({fmt::format("{}{}", prefix, kAxisNames[static_cast<std::size_t>(d)]),
-                          [v, d](Index i) { return v(i, d); }});
+      scalars_.push_back(
+          {fmt::format("{}{}", prefix, kAxisNames[static_cast<std::size_t>(d)]), [v, d](Index i) { return v(i, d); }});
     }
   };
   auto scalar = [&](std::string name, ScalarField f) {

@@ -16,8 +16,8 @@ namespace rktsph::io {
 
 struct CatalogueField {
   std::string name;
-  int components = 1;                              // 1 or 3
-  std::function<double(Index i, int c)> value;     // c < components; 0 for padded components
+  int components = 1;                           // 1 or 3
+  std::function<double(Index i, int c)> value;  // c < components; 0 for padded components
 };
 
 /// A scalar reader, e.g. for a probe.

@@ -7,8 +7,7 @@
 
 namespace rktsph::io {
 
-Section::Section(const toml::table& table, std::string path,
-                 std::shared_ptr<const std::string> file)
+Section::Section(const toml::table& table, std::string path, std::shared_ptr<const std::string> file)
     : table_(&table), path_(std::move(path)), file_(std::move(file)) {}
 
 std::string Section::key_path(std::string_view key) const {
@@ -43,8 +42,7 @@ const toml::node& Section::required(std::string_view key) const {
   consumed_.insert(std::string(key));
   const toml::node* n = node(key);
   if (n == nullptr) {
-    throw InputError(fmt::format("{}: missing required key '{}'", location(table_),
-                                 key_path(key)));
+    throw InputError(fmt::format("{}: missing required key '{}'", location(table_), key_path(key)));
   }
   return *n;
 }
@@ -52,13 +50,20 @@ const toml::node& Section::required(std::string_view key) const {
 namespace {
 std::string_view type_name(const toml::node& n) {
   switch (n.type()) {
-    case toml::node_type::string: return "a string";
-    case toml::node_type::integer: return "an integer";
-    case toml::node_type::floating_point: return "a number";
-    case toml::node_type::boolean: return "a boolean";
-    case toml::node_type::array: return "an array";
-    case toml::node_type::table: return "a table";
-    default: return "a date or time";
+    case toml::node_type::string:
+      return "a string";
+    case toml::node_type::integer:
+      return "an integer";
+    case toml::node_type::floating_point:
+      return "a number";
+    case toml::node_type::boolean:
+      return "a boolean";
+    case toml::node_type::array:
+      return "an array";
+    case toml::node_type::table:
+      return "a table";
+    default:
+      return "a date or time";
   }
 }
 }  // namespace
@@ -202,8 +207,7 @@ std::vector<Section> Section::tables(std::string_view key) const {
   const toml::node& n = required(key);
   const toml::array* arr = n.as_array();
   if (arr == nullptr) {
-    fail(key, fmt::format("must be an array of tables ([[{}]]), got {}", key_path(key),
-                          type_name(n)));
+    fail(key, fmt::format("must be an array of tables ([[{}]]), got {}", key_path(key), type_name(n)));
   }
   std::size_t i = 0;
   for (const toml::node& item : *arr) {
@@ -224,8 +228,8 @@ void Section::finish() const {
   for (const auto& [k, v] : *table_) {
     if (!consumed_.contains(k.str())) {
       std::vector<std::string> known(consumed_.begin(), consumed_.end());
-      throw InputError(fmt::format("{}, key '{}': unknown key (this table accepts: {})",
-                                   location(&v), key_path(k.str()), fmt::join(known, ", ")));
+      throw InputError(fmt::format("{}, key '{}': unknown key (this table accepts: {})", location(&v),
+                                   key_path(k.str()), fmt::join(known, ", ")));
     }
   }
 }

@@ -11,8 +11,7 @@
 namespace rktsph::io {
 
 std::string base64_encode(const unsigned char* data, std::size_t size) {
-  static constexpr char kTable[] =
-      "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  static constexpr char kTable[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
   std::string out;
   out.reserve(((size + 2) / 3) * 4);
   std::size_t i = 0;
@@ -48,8 +47,7 @@ std::string encode_block(const std::vector<T>& values) {
 
 }  // namespace
 
-void write_vtu(const std::string& path, const std::vector<double>& points,
-               const std::vector<PointField>& fields) {
+void write_vtu(const std::string& path, const std::vector<double>& points, const std::vector<PointField>& fields) {
   const std::size_t n = points.size() / 3;
   std::ofstream out(path, std::ios::binary);
   if (!out) throw SolverError(fmt::format("cannot write output file {}", path));
@@ -59,9 +57,10 @@ void write_vtu(const std::string& path, const std::vector<double>& points,
   out << fmt::format("<Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">\n", n, n);
   out << "<PointData>\n";
   for (const PointField& f : fields) {
-    out << fmt::format("<DataArray type=\"Float64\" Name=\"{}\" NumberOfComponents=\"{}\" "
-                       "format=\"binary\">\n",
-                       f.name, f.components);
+    out << fmt::format(
+        "<DataArray type=\"Float64\" Name=\"{}\" NumberOfComponents=\"{}\" "
+        "format=\"binary\">\n",
+        f.name, f.components);
     out << encode_block(f.values) << "\n</DataArray>\n";
   }
   out << "</PointData>\n<Points>\n"
@@ -77,8 +76,7 @@ void write_vtu(const std::string& path, const std::vector<double>& points,
       << encode_block(connectivity) << "\n</DataArray>\n";
   out << "<DataArray type=\"Int64\" Name=\"offsets\" format=\"binary\">\n"
       << encode_block(offsets) << "\n</DataArray>\n";
-  out << "<DataArray type=\"UInt8\" Name=\"types\" format=\"binary\">\n"
-      << encode_block(types) << "\n</DataArray>\n";
+  out << "<DataArray type=\"UInt8\" Name=\"types\" format=\"binary\">\n" << encode_block(types) << "\n</DataArray>\n";
   out << "</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
   if (!out) throw SolverError(fmt::format("failed writing output file {}", path));
 }

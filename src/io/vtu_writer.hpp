@@ -8,13 +8,12 @@ namespace rktsph::io {
 
 struct PointField {
   std::string name;
-  int components = 1;         // 1 (scalar) or 3 (vector)
+  int components = 1;          // 1 (scalar) or 3 (vector)
   std::vector<double> values;  // components * points
 };
 
 /// Write particles at `points` (x, y, z per point) with their fields.
-void write_vtu(const std::string& path, const std::vector<double>& points,
-               const std::vector<PointField>& fields);
+void write_vtu(const std::string& path, const std::vector<double>& points, const std::vector<PointField>& fields);
 
 /// A ParaView collection (.pvd): one entry per output time.
 class PvdCollection {

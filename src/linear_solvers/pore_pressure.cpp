@@ -7,8 +7,8 @@
 #include <chrono>
 #include <cmath>
 
-#include <Eigen/IterativeLinearSolvers>
 #include <fmt/format.h>
+#include <Eigen/IterativeLinearSolvers>
 
 #include "core/error.hpp"
 
@@ -27,11 +27,11 @@ constexpr Eigen::Index kParallelUnknowns = 20000;
 // a few thousand unknowns costs more in fork/join than it saves: 56 ms instead of ~1 ms per
 // solve was measured on 2 busy cores.)
 struct PorePressureSolver::Impl {
-  Sparse K;        // free-free block of I/(Q dt) - k_eff S
-  Sparse S_fd;     // free rows, drained columns of k_eff S (+ tau S_f) (Dirichlet values to the right-hand side)
-  Sparse D;        // free rows of L - S, all columns (deferred correction)
-  Sparse S_f;      // free rows of L (S without the deferred correction), all columns (incremental projection)
-  Sparse F;        // free rows of tau (T G)_f, all columns (explicit half of the pressure filter)
+  Sparse K;     // free-free block of I/(Q dt) - k_eff S
+  Sparse S_fd;  // free rows, drained columns of k_eff S (+ tau S_f) (Dirichlet values to the right-hand side)
+  Sparse D;     // free rows of L - S, all columns (deferred correction)
+  Sparse S_f;   // free rows of L (S without the deferred correction), all columns (incremental projection)
+  Sparse F;     // free rows of tau (T G)_f, all columns (explicit half of the pressure filter)
   Eigen::ConjugateGradient<Sparse, Eigen::Lower, Eigen::DiagonalPreconditioner<double>> cg_diag;
   Eigen::ConjugateGradient<Sparse, Eigen::Lower, Eigen::IncompleteCholesky<double>> cg_ic;
   // Large systems: the full (both triangles) product, which Eigen runs on its OpenMP threads for a
@@ -47,9 +47,9 @@ PorePressureSolver::~PorePressureSolver() = default;
 
 const PorePressureSolver::Sparse& PorePressureSolver::matrix() const { return impl_->K; }
 
-PorePressureSolver::PorePressureSolver(const Sparse& full, const Sparse& symmetric,
-                                       const std::vector<bool>& dirichlet, const Settings& settings,
-                                       const Sparse* filter_symmetric, const Sparse* filter_explicit)
+PorePressureSolver::PorePressureSolver(const Sparse& full, const Sparse& symmetric, const std::vector<bool>& dirichlet,
+                                       const Settings& settings, const Sparse* filter_symmetric,
+                                       const Sparse* filter_explicit)
     : impl_(std::make_unique<Impl>()), settings_(settings) {
   const bool filtered = settings.filter > 0.0;
   if (filtered && (filter_symmetric == nullptr || filter_explicit == nullptr)) {
@@ -84,7 +84,8 @@ PorePressureSolver::PorePressureSolver(const Sparse& full, const Sparse& symmetr
           k.emplace_back(r, index_[j], -settings.filter * it.value());
         }
       }
-      for (Sparse::InnerIterator it(*filter_explicit, i); it; ++it) f.emplace_back(r, it.col(), settings.filter * it.value());
+      for (Sparse::InnerIterator it(*filter_explicit, i); it; ++it)
+        f.emplace_back(r, it.col(), settings.filter * it.value());
     }
     for (Sparse::InnerIterator it(symmetric, i); it; ++it) {
       const auto j = static_cast<std::size_t>(it.col());
@@ -179,9 +180,10 @@ void PorePressureSolver::solve(std::span<const double> source, std::span<const d
     run(m.cg_diag);
   }
   if (!ok || !std::isfinite(error)) {
-    throw SolverError(fmt::format("pore pressure: the conjugate gradient did not converge ({} iterations, "
-                                  "relative residual {:.3g}, tolerance {:.3g})",
-                                  iterations, error, settings_.tolerance));
+    throw SolverError(
+        fmt::format("pore pressure: the conjugate gradient did not converge ({} iterations, "
+                    "relative residual {:.3g}, tolerance {:.3g})",
+                    iterations, error, settings_.tolerance));
   }
   for (Eigen::Index r = 0; r < nf; ++r) p[static_cast<std::size_t>(free_[static_cast<std::size_t>(r)])] = m.x[r];
   ++stats_.solves;

@@ -30,16 +30,18 @@ struct PressureSolveStats {
   int last_iterations = 0;
   double last_error = 0.0;  // relative residual |K x - b| / |b| of the last solve
   double max_error = 0.0;
-  double seconds = 0.0;     // wall time in solve()
-  double mean_iterations() const { return solves > 0 ? static_cast<double>(total_iterations) / static_cast<double>(solves) : 0.0; }
+  double seconds = 0.0;  // wall time in solve()
+  double mean_iterations() const {
+    return solves > 0 ? static_cast<double>(total_iterations) / static_cast<double>(solves) : 0.0;
+  }
 };
 
 class PorePressureSolver {
  public:
   using Sparse = Eigen::SparseMatrix<double, Eigen::RowMajor>;
   struct Settings {
-    double inv_q_dt = 0.0;   // 1/(Q* dt), 1/(Pa s)
-    double k_eff = 0.0;      // k_w + S_w dt/rho, m^3 s/kg
+    double inv_q_dt = 0.0;    // 1/(Q* dt), 1/(Pa s)
+    double k_eff = 0.0;       // k_w + S_w dt/rho, m^3 s/kg
     double tolerance = 1e-8;  // relative residual
     int max_iterations = 2000;
     PressurePreconditioner preconditioner = PressurePreconditioner::diagonal;

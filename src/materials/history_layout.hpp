@@ -48,9 +48,7 @@ class HistoryLayout {
     return -1;
   }
   /// Slot of names()[name_index] for material m, or -1 if that material lacks it.
-  int slot(int material, std::size_t name_index) const {
-    return slot_[static_cast<std::size_t>(material)][name_index];
-  }
+  int slot(int material, std::size_t name_index) const { return slot_[static_cast<std::size_t>(material)][name_index]; }
 
  private:
   int stride_ = 0;

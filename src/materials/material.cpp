@@ -26,8 +26,12 @@ double ElasticConstants::p_wave_speed() const { return std::sqrt((K + 4.0 * G / 
 
 Sym6 ElasticConstants::apply(const Sym6& e) const {
   const double tr = e[0] + e[1] + e[2];
-  return {lambda * tr + 2.0 * G * e[0], lambda * tr + 2.0 * G * e[1], lambda * tr + 2.0 * G * e[2],
-          2.0 * G * e[3], 2.0 * G * e[4], 2.0 * G * e[5]};
+  return {lambda * tr + 2.0 * G * e[0],
+          lambda * tr + 2.0 * G * e[1],
+          lambda * tr + 2.0 * G * e[2],
+          2.0 * G * e[3],
+          2.0 * G * e[4],
+          2.0 * G * e[5]};
 }
 
 Sym6 ElasticConstants::apply_inverse(const Sym6& s) const {
@@ -37,20 +41,16 @@ Sym6 ElasticConstants::apply_inverse(const Sym6& s) const {
   return {a + b * s[0], a + b * s[1], a + b * s[2], b * s[3], b * s[4], b * s[5]};
 }
 
-void Material::source_rate(const Sym6& /*sigma*/, const double* /*state*/, Sym6& dsigma,
-                           double* dstate) const {
+void Material::source_rate(const Sym6& /*sigma*/, const double* /*state*/, Sym6& dsigma, double* dstate) const {
   dsigma.fill(0.0);
   for (int i = 0; i < state_size(); ++i) dstate[i] = 0.0;
 }
 
-double Material::relaxation_rate(const Sym6& /*sigma*/, const double* /*state*/) const {
-  return 0.0;
-}
+double Material::relaxation_rate(const Sym6& /*sigma*/, const double* /*state*/) const { return 0.0; }
 
 SourceStats Material::advance_source(double tau, const SourceBatch& b) const {
   return detail::integrate_source_batch(
-      tau, b, state_size(),
-      [this](const Sym6& s, const double* k, Sym6& ds, double* dk) { source_rate(s, k, ds, dk); },
+      tau, b, state_size(), [this](const Sym6& s, const double* k, Sym6& ds, double* dk) { source_rate(s, k, ds, dk); },
       [this](const Sym6& s, const double* k) { return relaxation_rate(s, k); });
 }
 

@@ -124,8 +124,7 @@ class Material {
   /// False for a purely elastic model: the solver then skips the source integration.
   virtual bool has_source() const { return false; }
   /// Pointwise source rate: dsigma = -D^e : eps_vp_dot, dstate = d kappa / dt.
-  virtual void source_rate(const Sym6& sigma, const double* state, Sym6& dsigma,
-                           double* dstate) const;
+  virtual void source_rate(const Sym6& sigma, const double* state, Sym6& dsigma, double* dstate) const;
   /// Estimate (1/s) of the largest relaxation rate of the source at this state, used to
   /// sub-step RK4 (method-notes §4.3). Zero when no flow occurs.
   virtual double relaxation_rate(const Sym6& sigma, const double* state) const;

@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
-#include <Eigen/Dense>
 #include <fmt/format.h>
+#include <Eigen/Dense>
 
 #include "core/error.hpp"
 
@@ -29,9 +29,7 @@ LoadPath LoadPath::undrained_triaxial(double axial_rate) {
   return strain_path({-0.5 * axial_rate, axial_rate, -0.5 * axial_rate, 0.0, 0.0, 0.0});
 }
 
-LoadPath LoadPath::oedometric(double axial_rate) {
-  return strain_path({0.0, axial_rate, 0.0, 0.0, 0.0, 0.0});
-}
+LoadPath LoadPath::oedometric(double axial_rate) { return strain_path({0.0, axial_rate, 0.0, 0.0, 0.0, 0.0}); }
 
 LoadPath LoadPath::plane_strain_compression(double axial_rate) {
   LoadPath p = strain_path({0.0, axial_rate, 0.0, 0.0, 0.0, 0.0});
@@ -39,9 +37,7 @@ LoadPath LoadPath::plane_strain_compression(double axial_rate) {
   return p;
 }
 
-LoadPath LoadPath::simple_shear(double shear_rate) {
-  return strain_path({0.0, 0.0, 0.0, 0.5 * shear_rate, 0.0, 0.0});
-}
+LoadPath LoadPath::simple_shear(double shear_rate) { return strain_path({0.0, 0.0, 0.0, 0.5 * shear_rate, 0.0, 0.0}); }
 
 namespace {
 
@@ -145,14 +141,14 @@ PathResult integrate_path(const Material& material, const Sym6& sigma0, const Lo
     // surface the rate is 0, but the loading can carry the point outside within the step.
     rate(sig, k.data(), ds[0], dummy, kel.data(), false);
     for (std::size_t c = 0; c < 6; ++c) sst[c] = sig[c] + dt * ds[0][c];
-    const double lam = std::max(material.relaxation_rate(sig, k.data()),
-                                material.relaxation_rate(sst, k.data()));
+    const double lam = std::max(material.relaxation_rate(sig, k.data()), material.relaxation_rate(sst, k.data()));
     res.max_relaxation_rate = std::max(res.max_relaxation_rate, lam);
     const double want = std::ceil(lam * dt / path.relaxation_target);
     if (!(want <= 1e7)) {
-      throw SolverError(fmt::format("material point: relaxation rate {:.3g} 1/s is too stiff "
-                                    "for the step {:.3g} s",
-                                    lam, dt));
+      throw SolverError(
+          fmt::format("material point: relaxation rate {:.3g} 1/s is too stiff "
+                      "for the step {:.3g} s",
+                      lam, dt));
     }
     const long nsub = std::max(1L, static_cast<long>(want));
     const double h = dt / static_cast<double>(nsub);
@@ -160,7 +156,8 @@ PathResult integrate_path(const Material& material, const Sym6& sigma0, const Lo
       constexpr double kFrac[4] = {0.0, 0.5, 0.5, 1.0};
       for (int s = 0; s < 4; ++s) {
         for (std::size_t c = 0; c < 6; ++c) sst[c] = s == 0 ? sig[c] : sig[c] + kFrac[s] * h * ds[s - 1][c];
-        for (std::size_t j = 0; j < unk; ++j) kt[j] = s == 0 ? k[j] : k[j] + kFrac[s] * h * dk[static_cast<std::size_t>(s - 1)][j];
+        for (std::size_t j = 0; j < unk; ++j)
+          kt[j] = s == 0 ? k[j] : k[j] + kFrac[s] * h * dk[static_cast<std::size_t>(s - 1)][j];
         rate(sst, kt.data(), ds[s], de[s], dk[static_cast<std::size_t>(s)].data());
       }
       for (std::size_t c = 0; c < 6; ++c) {

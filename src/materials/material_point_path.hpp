@@ -22,7 +22,7 @@ enum class Control { strain, stress };
 struct LoadPath {
   std::array<Control, 6> control{Control::strain, Control::strain, Control::strain,
                                  Control::strain, Control::strain, Control::strain};
-  Sym6 rate{};  // eps_dot (tensor shear) for strain-controlled, sigma_dot for stress-controlled
+  Sym6 rate{};            // eps_dot (tensor shear) for strain-controlled, sigma_dot for stress-controlled
   double duration = 0.0;  // s
   double dt = 0.0;        // s, output/step interval; <= 0 picks duration/1000
   int output_every = 1;   // steps between recorded points (the first and last are always kept)
@@ -52,7 +52,7 @@ struct PathPoint {
 struct PathResult {
   std::vector<PathPoint> points;
   long steps = 0;
-  long substeps = 0;     // total RK4 sub-steps
+  long substeps = 0;                 // total RK4 sub-steps
   double max_relaxation_rate = 0.0;  // 1/s, largest estimate met
 };
 

@@ -24,8 +24,8 @@ namespace rktsph {
 template <class Surface, class Hardening>
 class PerzynaMaterial final : public Material {
  public:
-  PerzynaMaterial(std::string model, ElasticConstants elastic, Surface surface,
-                  Hardening hardening, Overstress overstress, double fluidity)
+  PerzynaMaterial(std::string model, ElasticConstants elastic, Surface surface, Hardening hardening,
+                  Overstress overstress, double fluidity)
       : Material(elastic),
         model_(std::move(model)),
         names_(Hardening::names()),
@@ -42,15 +42,14 @@ class PerzynaMaterial final : public Material {
     hardening_.initial_state(surface_.value(sigma, 1.0), state);
     const double Y = hardening_.size(state);
     if (!(Y > 0.0)) {
-      throw InputError(fmt::format(
-          "{}: the initial stress gives a non-positive yield size {} Pa (with an OCR the "
-          "initial stress must be compressive; give p_c0 instead)",
-          model_, Y));
+      throw InputError(
+          fmt::format("{}: the initial stress gives a non-positive yield size {} Pa (with an OCR the "
+                      "initial stress must be compressive; give p_c0 instead)",
+                      model_, Y));
     }
   }
 
-  void source_rate(const Sym6& sigma, const double* state, Sym6& dsigma,
-                   double* dstate) const override {
+  void source_rate(const Sym6& sigma, const double* state, Sym6& dsigma, double* dstate) const override {
     rate(sigma, state, dsigma, dstate);
   }
 
@@ -66,8 +65,8 @@ class PerzynaMaterial final : public Material {
     if (!(slope > 0.0)) return 0.0;
     const Sym6 m = surface_.flow(sigma, Y);
     const Sym6 n = surface_.gradient(sigma, Y);
-    const double stiff = std::abs(tensor::ddot(n, elastic().apply(m))) +
-                         (1.0 + x) * std::abs(hardening_.size_rate_per_flow(m, state));
+    const double stiff =
+        std::abs(tensor::ddot(n, elastic().apply(m))) + (1.0 + x) * std::abs(hardening_.size_rate_per_flow(m, state));
     return fluidity_ * slope * stiff / Y;
   }
 

@@ -24,8 +24,8 @@ std::unique_ptr<Material> make_perzyna_cam_clay(const CamClayParameters& p) {
   h.v0_over_lambda_kappa = (1.0 + p.e0) / (p.lambda - p.kappa);
   h.p_c0 = p.p_c0;
   h.ocr = p.ocr;
-  return std::make_unique<PerzynaMaterial<CamClaySurface, CamClayHardening>>(
-      "perzyna_cam_clay", p.elastic, surf, h, p.overstress, p.fluidity);
+  return std::make_unique<PerzynaMaterial<CamClaySurface, CamClayHardening>>("perzyna_cam_clay", p.elastic, surf, h,
+                                                                             p.overstress, p.fluidity);
 }
 
 }  // namespace rktsph

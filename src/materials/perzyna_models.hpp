@@ -22,14 +22,14 @@ std::unique_ptr<Material> make_perzyna_von_mises(const VonMisesParameters& param
 /// perzyna_cam_clay (method-notes §1.8): modified Cam-Clay with p_c hardening.
 struct CamClayParameters {
   ElasticConstants elastic;
-  double M = 1.0;                  // critical-state slope in triaxial compression
-  bool lode_dependent_M = false;   // M(theta) instead of constant M
-  double lambda = 0.0;             // virgin compression slope
-  double kappa = 0.0;              // swelling slope
-  double e0 = 0.0;                 // initial void ratio
-  double p_c0 = 0.0;               // Pa; used when > 0
-  double ocr = 0.0;                // used when p_c0 = 0: p_c0 = ocr x the size of the initial stress
-  double fluidity = 0.0;           // gamma, 1/s
+  double M = 1.0;                 // critical-state slope in triaxial compression
+  bool lode_dependent_M = false;  // M(theta) instead of constant M
+  double lambda = 0.0;            // virgin compression slope
+  double kappa = 0.0;             // swelling slope
+  double e0 = 0.0;                // initial void ratio
+  double p_c0 = 0.0;              // Pa; used when > 0
+  double ocr = 0.0;               // used when p_c0 = 0: p_c0 = ocr x the size of the initial stress
+  double fluidity = 0.0;          // gamma, 1/s
   Overstress overstress;
 };
 std::unique_ptr<Material> make_perzyna_cam_clay(const CamClayParameters& parameters);

@@ -17,8 +17,7 @@ namespace rktsph::detail {
 /// rate(sigma, state, dsigma, dstate) is the source rate; relax(sigma, state) its relaxation
 /// rate estimate in 1/s. nk is the number of history variables per particle.
 template <class RateFn, class RelaxFn>
-SourceStats integrate_source_batch(double tau, const SourceBatch& b, int nk, RateFn&& rate,
-                                   RelaxFn&& relax) {
+SourceStats integrate_source_batch(double tau, const SourceBatch& b, int nk, RateFn&& rate, RelaxFn&& relax) {
   constexpr int kMaxState = 16;  // a model carries at most a handful of history variables
   if (nk > kMaxState) throw SolverError("material carries too many history variables");
   const int ns = b.stress_components;
@@ -49,10 +48,10 @@ SourceStats integrate_source_batch(double tau, const SourceBatch& b, int nk, Rat
     }
     const double want = std::ceil(lam * tau / Material::rk4_stability_target);
     if (!(want <= static_cast<double>(Material::max_substeps))) {
-      throw SolverError(fmt::format(
-          "the viscoplastic source is too stiff: relaxation rate {:.3g} 1/s needs {:.3g} RK4 "
-          "sub-steps per step (limit {}); reduce the fluidity or the time step",
-          lam, want, Material::max_substeps));
+      throw SolverError(
+          fmt::format("the viscoplastic source is too stiff: relaxation rate {:.3g} 1/s needs {:.3g} RK4 "
+                      "sub-steps per step (limit {}); reduce the fluidity or the time step",
+                      lam, want, Material::max_substeps));
     }
     const long substeps = std::max(1L, static_cast<long>(want));
     stats.max_substeps = std::max(stats.max_substeps, substeps);

@@ -20,9 +20,7 @@ inline double ddot(const Sym6& a, const Sym6& b) {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + 2.0 * (a[3] * b[3] + a[4] * b[4] + a[5] * b[5]);
 }
 
-inline Sym6 scaled(const Sym6& a, double c) {
-  return {c * a[0], c * a[1], c * a[2], c * a[3], c * a[4], c * a[5]};
-}
+inline Sym6 scaled(const Sym6& a, double c) { return {c * a[0], c * a[1], c * a[2], c * a[3], c * a[4], c * a[5]}; }
 
 /// Matrix product a·a of a symmetric tensor with itself.
 inline Sym6 square(const Sym6& a) {

@@ -14,8 +14,7 @@ void UniaxialStressMaterial::initial_state(const Sym6& sigma, double* state) con
   inner_->initial_state(uniaxial(sigma), state);
 }
 
-void UniaxialStressMaterial::source_rate(const Sym6& sigma, const double* state, Sym6& dsigma,
-                                         double* dstate) const {
+void UniaxialStressMaterial::source_rate(const Sym6& sigma, const double* state, Sym6& dsigma, double* dstate) const {
   Sym6 inner_rate;
   inner_->source_rate(uniaxial(sigma), state, inner_rate, dstate);
   // eps_vp_dot = -C^e : dsigma_inner; the bar's stress rate is -E eps_vp_xx.

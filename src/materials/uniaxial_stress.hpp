@@ -25,8 +25,7 @@ class UniaxialStressMaterial final : public Material {
   std::span<const std::string> state_names() const override { return inner_->state_names(); }
   void initial_state(const Sym6& sigma, double* state) const override;
   bool has_source() const override { return inner_->has_source(); }
-  void source_rate(const Sym6& sigma, const double* state, Sym6& dsigma,
-                   double* dstate) const override;
+  void source_rate(const Sym6& sigma, const double* state, Sym6& dsigma, double* dstate) const override;
   double relaxation_rate(const Sym6& sigma, const double* state) const override;
 
   const Material& inner() const { return *inner_; }

@@ -1,8 +1,8 @@
 #pragma once
 // Cell list (method-notes §3.8, the cell linked list stored as sorted arrays): the bounding box is
 // split into square cells of side equal to the search radius (or a fraction of it), and a query
-// scans its own cell and the 3^Dim (5^Dim, ...) around it. Built once in the small-deformation solvers; cheap enough to rebuild every
-// step when particles move.
+// scans its own cell and the 3^Dim (5^Dim, ...) around it. Built once in the small-deformation solvers; cheap enough to
+// rebuild every step when particles move.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -50,7 +50,9 @@ class CellList {
   void for_each_range(const Vec<Dim>& x, F&& f) const;
   std::size_t cell_index(const std::array<int, Dim>& c) const {
     std::size_t idx = 0;
-    for (int d = Dim - 1; d >= 0; --d) idx = idx * static_cast<std::size_t>(n_[static_cast<std::size_t>(d)]) + static_cast<std::size_t>(c[static_cast<std::size_t>(d)]);
+    for (int d = Dim - 1; d >= 0; --d)
+      idx = idx * static_cast<std::size_t>(n_[static_cast<std::size_t>(d)]) +
+            static_cast<std::size_t>(c[static_cast<std::size_t>(d)]);
     return idx;
   }
   double radius_;
@@ -61,8 +63,8 @@ class CellList {
   // The points sorted by cell (counting sort, stable: increasing index within a cell), with a
   // copy of their positions in that order. The cells of one x-row are consecutive, so a query
   // scans 3^(Dim-1) contiguous ranges instead of chasing a linked list through the particles.
-  std::vector<Index> cell_start_;  // points of cell c: [cell_start_[c], cell_start_[c+1])
-  std::vector<Index> index_;       // particle index, in cell order
+  std::vector<Index> cell_start_;   // points of cell c: [cell_start_[c], cell_start_[c+1])
+  std::vector<Index> index_;        // particle index, in cell order
   std::vector<Vec<Dim>> position_;  // its position, in cell order
 };
 

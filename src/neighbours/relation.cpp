@@ -37,7 +37,9 @@ void Relation<Dim>::build(const std::vector<Vec<Dim>>& targets, const std::vecto
       },
       exec::Schedule::dynamic, nt);
   offsets_.assign(static_cast<std::size_t>(nt) + 1, 0);
-  for (Index a = 0; a < nt; ++a) offsets_[static_cast<std::size_t>(a) + 1] = offsets_[static_cast<std::size_t>(a)] + counts[static_cast<std::size_t>(a)];
+  for (Index a = 0; a < nt; ++a)
+    offsets_[static_cast<std::size_t>(a) + 1] =
+        offsets_[static_cast<std::size_t>(a)] + counts[static_cast<std::size_t>(a)];
   indices_.clear();
   indices_.reserve(static_cast<std::size_t>(offsets_.back()));
   for (auto& b : block_indices) {

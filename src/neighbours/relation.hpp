@@ -30,8 +30,8 @@ template <int Dim>
 class Relation {
  public:
   /// (Re)build from the current positions.
-  void build(const std::vector<Vec<Dim>>& targets, const std::vector<Vec<Dim>>& sources,
-             const RelationOptions& options, const exec::Threads& policy = {});
+  void build(const std::vector<Vec<Dim>>& targets, const std::vector<Vec<Dim>>& sources, const RelationOptions& options,
+             const exec::Threads& policy = {});
 
   Index rows() const { return static_cast<Index>(offsets_.size()) - 1; }
   std::size_t pairs() const { return indices_.size(); }

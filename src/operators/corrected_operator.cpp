@@ -111,8 +111,7 @@ struct PatternTable {
 
   // Pattern whose offsets equal `off` and whose geometry matches `geo` within the tolerances,
   // or -1.
-  Index find(std::uint64_t k, const Index* off, const double* geo, std::size_t n, double tol_x,
-             double tol_v) const {
+  Index find(std::uint64_t k, const Index* off, const double* geo, std::size_t n, double tol_x, double tol_v) const {
     const auto it = head.find(k);
     if (it == head.end()) return -1;
     for (Index p = it->second; p >= 0; p = next_same_key[static_cast<std::size_t>(p)]) {
@@ -123,7 +122,8 @@ struct PatternTable {
       for (std::size_t i = 0; i < n && same; ++i) {
         const double* g = &geometry[(b + i) * G];
         for (int d = 0; d < Dim; ++d) same = same && std::abs(g[d] - geo[i * G + static_cast<std::size_t>(d)]) <= tol_x;
-        same = same && std::abs(g[Dim] - geo[i * G + Dim]) <= tol_v * std::max(std::abs(g[Dim]), std::abs(geo[i * G + Dim]));
+        same = same &&
+               std::abs(g[Dim] - geo[i * G + Dim]) <= tol_v * std::max(std::abs(g[Dim]), std::abs(geo[i * G + Dim]));
       }
       if (same) return p;
     }
@@ -277,7 +277,8 @@ CorrectedOperator<Dim> build_corrected_operator(const Relation<Dim>& relation, c
       map[qu] = g;
     }
     const Index end = std::min(nt, (blk + 1) * kBuildBlock);
-    for (Index a = blk * kBuildBlock; a < end; ++a) pattern[static_cast<std::size_t>(a)] = map[static_cast<std::size_t>(pattern[static_cast<std::size_t>(a)])];
+    for (Index a = blk * kBuildBlock; a < end; ++a)
+      pattern[static_cast<std::size_t>(a)] = map[static_cast<std::size_t>(pattern[static_cast<std::size_t>(a)])];
     table = PatternTable<Dim>();  // release the block's storage as we go
   }
 
@@ -372,16 +373,16 @@ DifferenceGradient<Dim> build_difference_gradient(const std::vector<Vec<Dim>>& t
   return build_difference_gradient(relation, selected, sources, kernel);
 }
 
-#define RKTSPH_INSTANTIATE(D)                                                                                  \
-  template RelationOptions operator_relation_options<D>(const CubicSplineKernel<D>&);                          \
-  template RelationOptions difference_gradient_relation_options<D>(const CubicSplineKernel<D>&);               \
-  template CorrectedOperator<D> build_corrected_operator<D>(const Relation<D>&, const std::vector<Vec<D>>&,      \
-                                                            const ParticleSet<D>&, const CubicSplineKernel<D>&, \
-                                                            const OperatorOptions&);                           \
-  template CorrectedOperator<D> build_corrected_operator<D>(const std::vector<Vec<D>>&, const ParticleSet<D>&,   \
-                                                            const CubicSplineKernel<D>&, const OperatorOptions&); \
-  template DifferenceGradient<D> build_difference_gradient<D>(const Relation<D>&, const std::vector<Vec<D>>&,    \
-                                                              const ParticleSet<D>&, const CubicSplineKernel<D>&); \
+#define RKTSPH_INSTANTIATE(D)                                                                                        \
+  template RelationOptions operator_relation_options<D>(const CubicSplineKernel<D>&);                                \
+  template RelationOptions difference_gradient_relation_options<D>(const CubicSplineKernel<D>&);                     \
+  template CorrectedOperator<D> build_corrected_operator<D>(const Relation<D>&, const std::vector<Vec<D>>&,          \
+                                                            const ParticleSet<D>&, const CubicSplineKernel<D>&,      \
+                                                            const OperatorOptions&);                                 \
+  template CorrectedOperator<D> build_corrected_operator<D>(const std::vector<Vec<D>>&, const ParticleSet<D>&,       \
+                                                            const CubicSplineKernel<D>&, const OperatorOptions&);    \
+  template DifferenceGradient<D> build_difference_gradient<D>(const Relation<D>&, const std::vector<Vec<D>>&,        \
+                                                              const ParticleSet<D>&, const CubicSplineKernel<D>&);   \
   template DifferenceGradient<D> build_difference_gradient<D>(const std::vector<Vec<D>>&, const std::vector<Index>&, \
                                                               const ParticleSet<D>&, const CubicSplineKernel<D>&);
 RKTSPH_INSTANTIATE(1)

@@ -51,8 +51,8 @@ struct CorrectedOperator {
   // sums contiguous blocks with vector instructions (the rows of one lattice line).
   static constexpr Index kMaxRun = 16;
   std::vector<Index> run_start;  // rows of run r: [run_start[r], run_start[r+1])
-  Index degenerate_rows = 0;   // rows that fell back to Shepard / uncorrected (too few sources)
-  std::size_t pair_count = 0;  // pairs summed over all rows (the uncompressed CSR length)
+  Index degenerate_rows = 0;     // rows that fell back to Shepard / uncorrected (too few sources)
+  std::size_t pair_count = 0;    // pairs summed over all rows (the uncompressed CSR length)
 
   /// The pairs of one row: k in [begin, end) indexes offset/interp/grad, the source of pair k
   /// is base + offset[k].
@@ -85,7 +85,7 @@ template <int Dim>
 struct DifferenceGradient {
   std::vector<Index> row_start;
   std::vector<Index> source;
-  std::vector<Vec<Dim>> weight;   // c_ab
+  std::vector<Vec<Dim>> weight;      // c_ab
   std::vector<Vec<Dim>> weight_sum;  // sum_b c_ab, per row
 };
 

@@ -132,12 +132,12 @@ NodeLaplacian<Dim> build_node_laplacian(const ParticleSet<Dim>& nodes, const Cub
   return build_node_laplacian(relation, nodes, kernel, wall_axes, mirrors, mirror_mask);
 }
 
-#define RKTSPH_INSTANTIATE(D)                                                                                    \
-  template RelationOptions laplacian_relation_options<D>(const CubicSplineKernel<D>&);                           \
-  template NodeLaplacian<D> build_node_laplacian<D>(const Relation<D>&, const ParticleSet<D>&,                   \
-                                                    const CubicSplineKernel<D>&, const std::vector<std::uint8_t>&, \
-                                                    const std::vector<MirrorPlane>&, const std::vector<std::uint8_t>&); \
-  template NodeLaplacian<D> build_node_laplacian<D>(const ParticleSet<D>&, const CubicSplineKernel<D>&,          \
+#define RKTSPH_INSTANTIATE(D)                                                                                          \
+  template RelationOptions laplacian_relation_options<D>(const CubicSplineKernel<D>&);                                 \
+  template NodeLaplacian<D> build_node_laplacian<D>(                                                                   \
+      const Relation<D>&, const ParticleSet<D>&, const CubicSplineKernel<D>&, const std::vector<std::uint8_t>&,        \
+      const std::vector<MirrorPlane>&, const std::vector<std::uint8_t>&);                                              \
+  template NodeLaplacian<D> build_node_laplacian<D>(const ParticleSet<D>&, const CubicSplineKernel<D>&,                \
                                                     const std::vector<std::uint8_t>&, const std::vector<MirrorPlane>&, \
                                                     const std::vector<std::uint8_t>&);
 RKTSPH_INSTANTIATE(1)
@@ -187,7 +187,7 @@ template Eigen::SparseMatrix<double, Eigen::RowMajor> build_filter_gradient_part
 
 template <int Dim>
 std::array<Eigen::SparseMatrix<double, Eigen::RowMajor>, Dim> gradient_matrices(const CorrectedOperator<Dim>& op,
-                                                                                  Index columns) {
+                                                                                Index columns) {
   std::array<Eigen::SparseMatrix<double, Eigen::RowMajor>, Dim> grad;
   for (int d = 0; d < Dim; ++d) {
     std::vector<Eigen::Triplet<double>> t;
@@ -205,8 +205,11 @@ std::array<Eigen::SparseMatrix<double, Eigen::RowMajor>, Dim> gradient_matrices(
   return grad;
 }
 
-template std::array<Eigen::SparseMatrix<double, Eigen::RowMajor>, 1> gradient_matrices<1>(const CorrectedOperator<1>&, Index);
-template std::array<Eigen::SparseMatrix<double, Eigen::RowMajor>, 2> gradient_matrices<2>(const CorrectedOperator<2>&, Index);
-template std::array<Eigen::SparseMatrix<double, Eigen::RowMajor>, 3> gradient_matrices<3>(const CorrectedOperator<3>&, Index);
+template std::array<Eigen::SparseMatrix<double, Eigen::RowMajor>, 1> gradient_matrices<1>(const CorrectedOperator<1>&,
+                                                                                          Index);
+template std::array<Eigen::SparseMatrix<double, Eigen::RowMajor>, 2> gradient_matrices<2>(const CorrectedOperator<2>&,
+                                                                                          Index);
+template std::array<Eigen::SparseMatrix<double, Eigen::RowMajor>, 3> gradient_matrices<3>(const CorrectedOperator<3>&,
+                                                                                          Index);
 
 }  // namespace rktsph

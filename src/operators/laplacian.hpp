@@ -33,8 +33,8 @@
 #include "core/kernel.hpp"
 #include "core/types.hpp"
 #include "neighbours/relation.hpp"
-#include "particles/particle_set.hpp"
 #include "operators/corrected_operator.hpp"
+#include "particles/particle_set.hpp"
 
 namespace rktsph {
 
@@ -50,9 +50,9 @@ struct MirrorPlane {
 template <int Dim>
 struct NodeLaplacian {
   using Sparse = Eigen::SparseMatrix<double, Eigen::RowMajor>;
-  Sparse full;       // Schwaiger-corrected L (not symmetric), 1/m^2
-  Sparse symmetric;  // symmetric Brookshaw part S, 1/m^2
-  std::vector<double> c;  // normalisation c_I = (2/n_d) tr A_I^{-1}
+  Sparse full;                // Schwaiger-corrected L (not symmetric), 1/m^2
+  Sparse symmetric;           // symmetric Brookshaw part S, 1/m^2
+  std::vector<double> c;      // normalisation c_I = (2/n_d) tr A_I^{-1}
   Index degenerate_rows = 0;  // rows whose A_I was singular (c_I = 2, no gradient correction)
 };
 
@@ -79,8 +79,7 @@ template <int Dim>
 RelationOptions laplacian_relation_options(const CubicSplineKernel<Dim>& kernel);
 /// The same, with the relation built here.
 template <int Dim>
-NodeLaplacian<Dim> build_node_laplacian(const ParticleSet<Dim>& nodes,
-                                        const CubicSplineKernel<Dim>& kernel,
+NodeLaplacian<Dim> build_node_laplacian(const ParticleSet<Dim>& nodes, const CubicSplineKernel<Dim>& kernel,
                                         const std::vector<std::uint8_t>& wall_axes = {},
                                         const std::vector<MirrorPlane>& mirrors = {},
                                         const std::vector<std::uint8_t>& mirror_mask = {});
@@ -104,6 +103,6 @@ Eigen::SparseMatrix<double, Eigen::RowMajor> build_filter_gradient_part(
 /// `columns` its sources): (G_d f)_a = sum_k grad[k][d] f_{source(a, k)}.
 template <int Dim>
 std::array<Eigen::SparseMatrix<double, Eigen::RowMajor>, Dim> gradient_matrices(const CorrectedOperator<Dim>& op,
-                                                                                  Index columns);
+                                                                                Index columns);
 
 }  // namespace rktsph

@@ -56,12 +56,14 @@ inline void interpolate_run(const CorrectedOperator<Dim>& op, const double* src,
   const auto p = static_cast<std::size_t>(op.pattern[static_cast<std::size_t>(a0)]);
   double* sums[Dim + 1];
   for (int q = 0; q <= Dim; ++q) sums[q] = acc[q];
-  run_sums<Dim + 1, 16>(src + static_cast<std::size_t>(op.base[static_cast<std::size_t>(a0)]) * N, N,
-                        static_cast<std::size_t>(a1 - a0) * N, op.offset.data(), op.pattern_start[p],
-                        op.pattern_start[p + 1], [&](Index k, double* w) {
-                          w[0] = op.interp[static_cast<std::size_t>(k)];
-                          for (int d = 0; d < Dim; ++d) w[1 + d] = op.grad[static_cast<std::size_t>(k)][static_cast<std::size_t>(d)];
-                        }, sums);
+  run_sums<Dim + 1, 16>(
+      src + static_cast<std::size_t>(op.base[static_cast<std::size_t>(a0)]) * N, N,
+      static_cast<std::size_t>(a1 - a0) * N, op.offset.data(), op.pattern_start[p], op.pattern_start[p + 1],
+      [&](Index k, double* w) {
+        w[0] = op.interp[static_cast<std::size_t>(k)];
+        for (int d = 0; d < Dim; ++d) w[1 + d] = op.grad[static_cast<std::size_t>(k)][static_cast<std::size_t>(d)];
+      },
+      sums);
 }
 
 }  // namespace rktsph

@@ -29,8 +29,10 @@ enum class FieldType { f64, u8, i64 };
 
 template <class T>
 constexpr FieldType field_type_of() {
-  if constexpr (std::is_same_v<T, double>) return FieldType::f64;
-  else if constexpr (std::is_same_v<T, std::uint8_t>) return FieldType::u8;
+  if constexpr (std::is_same_v<T, double>)
+    return FieldType::f64;
+  else if constexpr (std::is_same_v<T, std::uint8_t>)
+    return FieldType::u8;
   else {
     static_assert(std::is_same_v<T, std::int64_t>, "fields hold double, std::uint8_t or std::int64_t");
     return FieldType::i64;

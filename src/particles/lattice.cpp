@@ -33,10 +33,10 @@ int lattice_coordinate(double x, double origin, double dx, const std::string& la
   const double t = (x - origin) / dx;
   const double r = std::round(t);
   if (std::abs(t - r) > 1e-6) {
-    throw InputError(fmt::format(
-        "{}: the block corner {} is not on the particle lattice (origin {}, spacing {}); "
-        "block extents must be whole multiples of the spacing",
-        label, x, origin, dx));
+    throw InputError(
+        fmt::format("{}: the block corner {} is not on the particle lattice (origin {}, spacing {}); "
+                    "block extents must be whole multiples of the spacing",
+                    label, x, origin, dx));
   }
   return static_cast<int>(r);
 }
@@ -82,9 +82,10 @@ LatticeParticles<Dim> generate_lattice(const std::vector<Block<Dim>>& blocks, do
       blo[b][d] = lattice_coordinate(blocks[b].min[i], origin[i], dx, blocks[b].label);
       bhi[b][d] = lattice_coordinate(blocks[b].max[i], origin[i], dx, blocks[b].label);
       if (bhi[b][d] <= blo[b][d]) {
-        throw InputError(fmt::format("{}: max must exceed min by at least one spacing ({} m) "
-                                     "along axis {}",
-                                     blocks[b].label, dx, kAxisNames[d]));
+        throw InputError(
+            fmt::format("{}: max must exceed min by at least one spacing ({} m) "
+                        "along axis {}",
+                        blocks[b].label, dx, kAxisNames[d]));
       }
       lo[d] = std::min(lo[d], blo[b][d]);
       hi[d] = std::max(hi[d], bhi[b][d]);
@@ -105,9 +106,8 @@ LatticeParticles<Dim> generate_lattice(const std::vector<Block<Dim>>& blocks, do
       z[d] = bhi[b][d] - lo[d];
     }
     // Later blocks overwrite earlier ones where they overlap (e.g. a footing inside soil).
-    for_each_index<Dim>(a, z, [&](const std::array<int, Dim>& c) {
-      lat.cell_material[lat.cell_index(c)] = blocks[b].material;
-    });
+    for_each_index<Dim>(
+        a, z, [&](const std::array<int, Dim>& c) { lat.cell_material[lat.cell_index(c)] = blocks[b].material; });
   }
 
   const double cell_volume = std::pow(dx, Dim);

@@ -32,8 +32,8 @@ template <int Dim>
 struct Lattice {
   double dx = 0.0;
   Vec<Dim> origin;
-  std::array<int, Dim> cells{};     // cells per axis of the bounding box
-  std::vector<int> cell_material;   // -1 where there is no material
+  std::array<int, Dim> cells{};    // cells per axis of the bounding box
+  std::vector<int> cell_material;  // -1 where there is no material
 
   std::size_t cell_index(const std::array<int, Dim>& c) const;
   /// Material of a cell, or -1 outside the lattice or for an empty cell.
@@ -66,7 +66,8 @@ struct BoundaryNodes {
   /// After ParticleSet::permute(order): node order[k] is now node k.
   void remap(const std::vector<Index>& order) {
     std::vector<Index> new_index(order.size());
-    for (std::size_t k = 0; k < order.size(); ++k) new_index[static_cast<std::size_t>(order[k])] = static_cast<Index>(k);
+    for (std::size_t k = 0; k < order.size(); ++k)
+      new_index[static_cast<std::size_t>(order[k])] = static_cast<Index>(k);
     std::vector<std::size_t> perm(node.size());
     for (std::size_t k = 0; k < perm.size(); ++k) perm[k] = k;
     for (auto& i : node) i = new_index[static_cast<std::size_t>(i)];

@@ -28,10 +28,10 @@ class ParticleSet {
   explicit ParticleSet(std::string name = "particles") : name_(std::move(name)) {}
 
   // Properties of every particle (one entry each, all of length size()).
-  std::vector<Vec<Dim>> position;      // m
-  std::vector<double> volume;          // m^Dim (per unit thickness in 2D, per unit area in 1D)
-  std::vector<double> density;         // kg/m^3
-  std::vector<int> material;           // index into the case's materials
+  std::vector<Vec<Dim>> position;       // m
+  std::vector<double> volume;           // m^Dim (per unit thickness in 2D, per unit area in 1D)
+  std::vector<double> density;          // kg/m^3
+  std::vector<int> material;            // index into the case's materials
   std::vector<std::int64_t> global_id;  // the same particle on every process and after sorting
 
   const std::string& name() const { return name_; }
@@ -136,9 +136,15 @@ class ParticleSet {
     void resize(std::size_t particles) {
       const std::size_t n = particles * static_cast<std::size_t>(info.components);
       switch (info.type) {
-        case FieldType::f64: f64.resize(n, 0.0); break;
-        case FieldType::u8: u8.resize(n, 0); break;
-        case FieldType::i64: i64.resize(n, 0); break;
+        case FieldType::f64:
+          f64.resize(n, 0.0);
+          break;
+        case FieldType::u8:
+          u8.resize(n, 0);
+          break;
+        case FieldType::i64:
+          i64.resize(n, 0);
+          break;
       }
     }
     std::size_t bytes() const {
@@ -146,9 +152,12 @@ class ParticleSet {
     }
     template <class T>
     T* data() {
-      if constexpr (std::is_same_v<std::remove_const_t<T>, double>) return f64.data();
-      else if constexpr (std::is_same_v<std::remove_const_t<T>, std::uint8_t>) return u8.data();
-      else return i64.data();
+      if constexpr (std::is_same_v<std::remove_const_t<T>, double>)
+        return f64.data();
+      else if constexpr (std::is_same_v<std::remove_const_t<T>, std::uint8_t>)
+        return u8.data();
+      else
+        return i64.data();
     }
   };
 

@@ -48,7 +48,8 @@ PorePressureStage<Dim>::PorePressureStage(StaggeredModel<Dim>& model) : m_(model
       for (int d = 0; d < Dim; ++d) {
         if ((m_.boundary.faces[b] >> (2 * d) & 3u) == 0) continue;  // not on a face normal to d
         bool held = false;
-        for (Index k = m_.constraints.begin(i); k < m_.constraints.end(i); ++k) held = held || m_.constraints[k].component == d;
+        for (Index k = m_.constraints.begin(i); k < m_.constraints.end(i); ++k)
+          held = held || m_.constraints[k].component == d;
         exposed = exposed || !held;
       }
       if (exposed) ++impermeable_stress_faces_;
@@ -94,7 +95,8 @@ PorePressureStage<Dim>::PorePressureStage(StaggeredModel<Dim>& model) : m_(model
     const auto grad = gradient_matrices<Dim>(node_operator_, static_cast<Index>(nn));
     const NodeLaplacian<Dim> plain = build_node_laplacian<Dim>(relation, nodes, m_.kernel);
     const PorePressureSolver::Sparse tg = build_filter_gradient_part<Dim>(plain.symmetric, nodes.position, grad);
-    solver_ = std::make_unique<PorePressureSolver>(lap.full, lap.symmetric, conditions_.drained, s, &plain.symmetric, &tg);
+    solver_ =
+        std::make_unique<PorePressureSolver>(lap.full, lap.symmetric, conditions_.drained, s, &plain.symmetric, &tg);
   } else {
     solver_ = std::make_unique<PorePressureSolver>(lap.full, lap.symmetric, conditions_.drained, s);
   }
@@ -106,8 +108,7 @@ std::string PorePressureStage<Dim>::instability_hint() const {
   return fmt::format(
       " (V3: impermeable faces carrying a total stress are unstable above C c_u/c_d = {}; "
       "here it is {:.2f}: time.cfl <= {:.3f})",
-      kUndrainedCourantLimit, undrained_courant_,
-      m_.time_step.courant * kUndrainedCourantLimit / undrained_courant_);
+      kUndrainedCourantLimit, undrained_courant_, m_.time_step.courant * kUndrainedCourantLimit / undrained_courant_);
 }
 
 template <int Dim>
@@ -137,7 +138,7 @@ void PorePressureStage<Dim>::run(const StepContext& context) {
   auto v = m_.nodes.view(m_.fields.velocity);
   double* pw = pw_view.data();
   // Same-set corrected gradient of a nodal scalar at node i (that of the velocity correction).
-  auto node_gradient = [&](const double* f, Index i, double (&g)[Dim]) {
+  auto node_gradient = [&](const double* f, Index i, double(&g)[Dim]) {
     for (int d = 0; d < Dim; ++d) g[d] = 0.0;
     for (Index k = pstart[pat[i]]; k < pstart[pat[i] + 1]; ++k) {
       const double fk = f[static_cast<std::size_t>(base[i] + off[k])];
@@ -165,7 +166,8 @@ void PorePressureStage<Dim>::run(const StepContext& context) {
       const auto r = to_nodes.row(i);
       for (Index k = r.begin; k < r.end; ++k) {
         const double* ve = skeleton[to_nodes.source(r, k)];
-        for (int d = 0; d < Dim; ++d) div += to_nodes.grad[static_cast<std::size_t>(k)][static_cast<std::size_t>(d)] * ve[d];
+        for (int d = 0; d < Dim; ++d)
+          div += to_nodes.grad[static_cast<std::size_t>(k)][static_cast<std::size_t>(d)] * ve[d];
       }
     } else {
       for (Index k = pstart[pat[i]]; k < pstart[pat[i] + 1]; ++k) {

@@ -8,9 +8,9 @@
 #include <vector>
 
 #include "bc/pore_pressure_conditions.hpp"
+#include "linear_solvers/pore_pressure.hpp"
 #include "schemes/stage.hpp"
 #include "schemes/staggered_model.hpp"
-#include "linear_solvers/pore_pressure.hpp"
 
 namespace rktsph {
 
@@ -29,7 +29,8 @@ class PorePressureStage final : public Stage {
   /// The stress points' pressure-free half-step velocity (solver.pressure_divergence =
   /// "stress_points"), filled by step 1; empty otherwise.
   FieldView<double, Dim> skeleton_velocity() {
-    return skeleton_.empty() ? FieldView<double, Dim>() : FieldView<double, Dim>(skeleton_.data(), m_.stress_points.size(), Dim);
+    return skeleton_.empty() ? FieldView<double, Dim>()
+                             : FieldView<double, Dim>(skeleton_.data(), m_.stress_points.size(), Dim);
   }
   /// 1/Q*, 1/Pa.
   double inverse_storage() const { return inv_storage_; }

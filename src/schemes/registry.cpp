@@ -21,9 +21,9 @@ std::vector<Entry<Dim>>& entries() {
     std::vector<Entry<Dim>> builtin;
     builtin.push_back({{"v1", "dry soil, small deformation: the staggered RKT-SPH step (method-notes §5.1)", false},
                        make_v1_scheme<Dim>});
-    builtin.push_back({{"v3", "saturated soil, small deformation: v-p_w fractional step with PCG (method-notes §5.3)",
-                        true},
-                       make_v3_scheme<Dim>});
+    builtin.push_back(
+        {{"v3", "saturated soil, small deformation: v-p_w fractional step with PCG (method-notes §5.3)", true},
+         make_v3_scheme<Dim>});
     return builtin;
   }();
   return list;
@@ -66,15 +66,15 @@ std::unique_ptr<Scheme> create_scheme(const std::string& name, StaggeredModel<Di
   for (const auto& e : entries<Dim>()) {
     if (e.info.name == name) return e.make(model);
   }
-  throw InputError(fmt::format("{}: unknown solver version '{}' for a {}D case (available: {})", model.setup.file,
-                               name, Dim, fmt::join(scheme_names<Dim>(), ", ")));
+  throw InputError(fmt::format("{}: unknown solver version '{}' for a {}D case (available: {})", model.setup.file, name,
+                               Dim, fmt::join(scheme_names<Dim>(), ", ")));
 }
 
-#define RKTSPH_INSTANTIATE(D)                                                                    \
-  template void register_scheme<D>(SchemeInfo, SchemeFactory<D>);                               \
-  template const SchemeInfo* find_scheme<D>(const std::string&);                                \
-  template std::vector<SchemeInfo> registered_schemes<D>();                                     \
-  template std::vector<std::string> scheme_names<D>();                                          \
+#define RKTSPH_INSTANTIATE(D)                                     \
+  template void register_scheme<D>(SchemeInfo, SchemeFactory<D>); \
+  template const SchemeInfo* find_scheme<D>(const std::string&);  \
+  template std::vector<SchemeInfo> registered_schemes<D>();       \
+  template std::vector<std::string> scheme_names<D>();            \
   template std::unique_ptr<Scheme> create_scheme<D>(const std::string&, StaggeredModel<D>&);
 RKTSPH_INSTANTIATE(1)
 RKTSPH_INSTANTIATE(2)

@@ -70,7 +70,8 @@ void Simulation<Dim>::step() {
         "material parameters",
         clock_.steps() + 1, t + clock_.dt(), bad, fmt::join(x.data(), x.data() + Dim, ", "), clock_.courant()));
   }
-  clock_.end_step(sums, model_->boundary_power(), scheme_->instability_hint ? scheme_->instability_hint() : std::string());
+  clock_.end_step(sums, model_->boundary_power(),
+                  scheme_->instability_hint ? scheme_->instability_hint() : std::string());
 }
 
 template <int Dim>

@@ -20,7 +20,8 @@ namespace rktsph {
 /// not have it).
 class HistoryView {
  public:
-  HistoryView(FieldView<const double, 0> values, const HistoryLayout& layout, const std::vector<int>& material, int name)
+  HistoryView(FieldView<const double, 0> values, const HistoryLayout& layout, const std::vector<int>& material,
+              int name)
       : values_(values), layout_(&layout), material_(&material), name_(name) {}
   template <std::integral I>
   double operator()(I i) const {
@@ -66,7 +67,9 @@ class Simulation {
   VectorView<Dim> stress_point_velocity() const {
     return VectorView<Dim>(stress_points().view(model_->fields.sp_velocity));
   }
-  StressView<Dim> stress_point_stress() const { return StressView<Dim>(stress_points().view(model_->fields.sp_stress)); }
+  StressView<Dim> stress_point_stress() const {
+    return StressView<Dim>(stress_points().view(model_->fields.sp_stress));
+  }
   /// Node pore pressure, Pa (compression positive); empty in a dry scheme.
   std::span<const double> node_pore_pressure() const;
   bool saturated() const { return model_->fields.pore_pressure.valid(); }

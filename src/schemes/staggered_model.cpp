@@ -89,12 +89,13 @@ StaggeredModel<Dim>::StaggeredModel(CaseSetup<Dim> case_setup, exec::Threads thr
 
   // Fields.
   const int history = materials.history.stride();
-  fields.velocity = nodes.template add_field<double, Dim>("velocity", axis_names("v", Dim), kFieldOutput | kFieldEvolving);
+  fields.velocity =
+      nodes.template add_field<double, Dim>("velocity", axis_names("v", Dim), kFieldOutput | kFieldEvolving);
   fields.stress = nodes.template add_field<double, NS>("stress", stress_names<Dim>(), kFieldOutput | kFieldEvolving);
   fields.displacement =
       nodes.template add_field<double, Dim>("displacement", axis_names("u", Dim), kFieldOutput | kFieldEvolving);
-  fields.history = nodes.template add_field<double, 0>("history", materials.history.names(),
-                                                       kFieldOutput | kFieldEvolving, history);
+  fields.history =
+      nodes.template add_field<double, 0>("history", materials.history.names(), kFieldOutput | kFieldEvolving, history);
   fields.sp_velocity =
       stress_points.template add_field<double, Dim>("velocity", axis_names("v", Dim), kFieldOutput | kFieldEvolving);
   fields.sp_stress =
@@ -107,7 +108,8 @@ StaggeredModel<Dim>::StaggeredModel(CaseSetup<Dim> case_setup, exec::Threads thr
 
   constraints.resolve(setup.boundaries, nodes, boundary, setup.dx);
   std::vector<Vec<Dim>> constrained_positions;
-  for (const Index i : constraints.constrained()) constrained_positions.push_back(nodes.position[static_cast<std::size_t>(i)]);
+  for (const Index i : constraints.constrained())
+    constrained_positions.push_back(nodes.position[static_cast<std::size_t>(i)]);
   Relation<Dim> relation;
   relation.build(constrained_positions, stress_points.position, difference_gradient_relation_options(kernel), policy);
   constrained_gradient = build_difference_gradient<Dim>(relation, constrained_positions, stress_points, kernel);
@@ -153,7 +155,8 @@ double StaggeredModel<Dim>::boundary_power() const {
         const double area = boundary.area[b][static_cast<std::size_t>(2 * d + side)];
         for (int k = 0; k < Dim; ++k) {
           // V3: the traction is the total stress sigma' - p_w 1.
-          const double sk = s(i, stress_slot<Dim>(k, d)) - (pore_pressure_ != nullptr && k == d ? pore_pressure_[i] : 0.0);
+          const double sk =
+              s(i, stress_slot<Dim>(k, d)) - (pore_pressure_ != nullptr && k == d ? pore_pressure_[i] : 0.0);
           power += area * sk * normal * v(i, k);
         }
       }

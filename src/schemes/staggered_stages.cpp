@@ -308,15 +308,17 @@ void VelocityFilter<Dim>::run(const StepContext&) {
         [&](Index r) {
           double acc[CorrectedOperator<Dim>::kMaxRun * Dim];
           double* sums[1] = {acc};
-          const Index e0 = en.run_start[static_cast<std::size_t>(r)], e1 = en.run_start[static_cast<std::size_t>(r) + 1];
+          const Index e0 = en.run_start[static_cast<std::size_t>(r)],
+                      e1 = en.run_start[static_cast<std::size_t>(r) + 1];
           const auto e0u = static_cast<std::size_t>(e0);
           const auto p = static_cast<std::size_t>(en.pattern[e0u]);
-          run_sums<1, 16>(node_field + static_cast<std::size_t>(en.base[e0u]) * Dim, Dim,
-                          static_cast<std::size_t>(e1 - e0) * Dim, en.offset.data(), en.pattern_start[p],
-                          en.pattern_start[p + 1],
-                          [&](Index k, double* w) { w[0] = en.interp[static_cast<std::size_t>(k)]; }, sums);
+          run_sums<1, 16>(
+              node_field + static_cast<std::size_t>(en.base[e0u]) * Dim, Dim, static_cast<std::size_t>(e1 - e0) * Dim,
+              en.offset.data(), en.pattern_start[p], en.pattern_start[p + 1],
+              [&](Index k, double* w) { w[0] = en.interp[static_cast<std::size_t>(k)]; }, sums);
           for (Index e = e0; e < e1; ++e) {
-            for (int d = 0; d < Dim; ++d) filter_sp(e, d) = acc[static_cast<std::size_t>(e - e0) * Dim + static_cast<std::size_t>(d)];
+            for (int d = 0; d < Dim; ++d)
+              filter_sp(e, d) = acc[static_cast<std::size_t>(e - e0) * Dim + static_cast<std::size_t>(d)];
           }
         },
         exec::Schedule::even, ne);
@@ -344,11 +346,11 @@ void VelocityFilter<Dim>::run(const StepContext&) {
   });
 }
 
-#define RKTSPH_INSTANTIATE(D)                                        \
-  template class ViscoplasticSources<D>;                            \
-  template class StressPointHalfStep<D, NoPressureGradient>;        \
-  template class StressPointHalfStep<D, PorePressureGradient<D>>;   \
-  template class NodeFullStep<D>;                                   \
+#define RKTSPH_INSTANTIATE(D)                                     \
+  template class ViscoplasticSources<D>;                          \
+  template class StressPointHalfStep<D, NoPressureGradient>;      \
+  template class StressPointHalfStep<D, PorePressureGradient<D>>; \
+  template class NodeFullStep<D>;                                 \
   template class VelocityFilter<D>;
 RKTSPH_INSTANTIATE(1)
 RKTSPH_INSTANTIATE(2)

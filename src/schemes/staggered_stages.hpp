@@ -54,8 +54,8 @@ struct NoPressureGradient {
 template <int Dim>
 struct PorePressureGradient {
   static constexpr bool kActive = true;
-  const double* pressure = nullptr;    // node p_w, Pa
-  FieldView<double, Dim> skeleton;      // stress points; empty when not kept
+  const double* pressure = nullptr;  // node p_w, Pa
+  FieldView<double, Dim> skeleton;   // stress points; empty when not kept
 };
 
 /// Step 1: interpolation and gradient of the nodal state at the stress points, half step of

@@ -23,8 +23,8 @@ inline double max_wave_speed(const std::vector<std::shared_ptr<const Material>>&
 }
 
 struct TimeStep {
-  double dt = 0.0;       // s
-  double courant = 0.0;  // c_max dt / dx
+  double dt = 0.0;          // s
+  double courant = 0.0;     // c_max dt / dx
   double wave_speed = 0.0;  // c_max, m/s
 };
 

@@ -23,9 +23,7 @@ struct ElasticBar {
   double rise_time;   // s; 0 for a step load
 
   double stress(double x, double t) const { return sigma0 * images(x, t, +1.0); }
-  double velocity(double x, double t) const {
-    return sigma0 / (density * wave_speed) * images(x, t, -1.0);
-  }
+  double velocity(double x, double t) const { return sigma0 / (density * wave_speed) * images(x, t, -1.0); }
 
   /// sum_k (-1)^k [S(t - (2kL + L - x)/c) + reflected * S(t - (2kL + L + x)/c)]: the incident and
   /// reflected image waves; stress adds them (reflected = +1), velocity subtracts them (-1).
@@ -36,8 +34,8 @@ struct ElasticBar {
       const double a = (2.0 * k * L + (L - x)) / c;
       if (a > t) break;
       const double sign = (k % 2 == 0) ? 1.0 : -1.0;
-      sum += sign * (smooth_step(t - a, rise_time) +
-                     reflected * smooth_step(t - (2.0 * k * L + (L + x)) / c, rise_time));
+      sum +=
+          sign * (smooth_step(t - a, rise_time) + reflected * smooth_step(t - (2.0 * k * L + (L + x)) / c, rise_time));
     }
     return sum;
   }

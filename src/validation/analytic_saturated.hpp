@@ -12,11 +12,11 @@ namespace rktsph::analytic {
 
 /// Column constants shared by both cases (docs/cases.md C4 and Case 13).
 struct SaturatedColumn {
-  double height = 10.0;         // H = L, m
-  double constrained = 0.0;     // drained constrained modulus M, Pa
-  double storage = 0.0;         // Q with 1/Q = n/K_f, Pa
-  double permeability = 0.0;    // k_w = k/gamma_w, m^3 s/kg
-  double density = 0.0;         // mixture density rho, kg/m^3
+  double height = 10.0;       // H = L, m
+  double constrained = 0.0;   // drained constrained modulus M, Pa
+  double storage = 0.0;       // Q with 1/Q = n/K_f, Pa
+  double permeability = 0.0;  // k_w = k/gamma_w, m^3 s/kg
+  double density = 0.0;       // mixture density rho, kg/m^3
 
   /// Undrained pore pressure per unit load, Q/(M+Q).
   double skempton() const { return storage / (constrained + storage); }

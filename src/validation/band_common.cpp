@@ -66,8 +66,10 @@ BandFit fit_band(const std::vector<double>& x, const std::vector<double>& y, con
     if (in_band(i)) ybar += y[i] / n;
   }
   int nu = 0, nl = 0;
-  const auto upper = principal_axis(x, y, [&](std::size_t i) { return in_band(i) && y[i] >= ybar; }, xi, yi, nu);
-  const auto lower = principal_axis(x, y, [&](std::size_t i) { return in_band(i) && y[i] < ybar; }, xi, yi, nl);
+  const auto upper = principal_axis(
+      x, y, [&](std::size_t i) { return in_band(i) && y[i] >= ybar; }, xi, yi, nu);
+  const auto lower = principal_axis(
+      x, y, [&](std::size_t i) { return in_band(i) && y[i] < ybar; }, xi, yi, nl);
   r.upper = upper.first;
   r.lower = lower.first;
   r.offset = std::min(upper.second, lower.second);

@@ -33,13 +33,13 @@ HistoryView node_history(const Simulation<2>& solver, const std::string& name, c
 /// The band fitted to the cloud of nodes where eps >= 50 % of its maximum inside the band
 /// region (docs/cases.md §1.3).
 struct BandFit {
-  double angle = 0.0;    // degrees to the horizontal: the pair's mean arm angle, or the whole cloud's axis
-  double whole = 0.0;    // principal axis of the whole cloud, degrees
-  double upper = 0.0;    // principal axis of the part of the cloud above its centroid, degrees
-  double lower = 0.0;    // ... below its centroid
-  double offset = 0.0;   // distance of the imperfection centre from the nearer arm's axis, m
-  bool pair = false;     // a conjugate pair ("<" or ">") rather than one straight band
-  int particles = 0;     // nodes in the cloud
+  double angle = 0.0;         // degrees to the horizontal: the pair's mean arm angle, or the whole cloud's axis
+  double whole = 0.0;         // principal axis of the whole cloud, degrees
+  double upper = 0.0;         // principal axis of the part of the cloud above its centroid, degrees
+  double lower = 0.0;         // ... below its centroid
+  double offset = 0.0;        // distance of the imperfection centre from the nearer arm's axis, m
+  bool pair = false;          // a conjugate pair ("<" or ">") rather than one straight band
+  int particles = 0;          // nodes in the cloud
   std::vector<char> in_band;  // per node: in the cloud
 };
 

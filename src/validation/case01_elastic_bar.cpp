@@ -31,15 +31,15 @@ struct BarRun {
 };
 
 struct BarResult {
-  std::vector<double> snapshot_times;   // in units of L/c, as requested
-  std::vector<double> snapshot_e1;      // L1 relative error of sigma at each snapshot
+  std::vector<double> snapshot_times;                // in units of L/c, as requested
+  std::vector<double> snapshot_e1;                   // L1 relative error of sigma at each snapshot
   std::vector<std::vector<double>> x, sigma, exact;  // profiles at each snapshot
-  double max_abs_stress = 0.0;          // over all steps and nodes, / |sigma0|
-  double max_zigzag = 0.0;              // RMS second difference away from fronts, / |sigma0|
-  double zigzag_early = 0.0;            // its maximum over the first 5 L/c
-  double zigzag_late = 0.0;             // its maximum over the last 5 L/c
-  double max_energy_error = 0.0;        // |imbalance| / (sigma0 2 sigma0 L / E)
-  double front_error = 0.0;             // |front - exact| at 0.5 L/c, in dx
+  double max_abs_stress = 0.0;                       // over all steps and nodes, / |sigma0|
+  double max_zigzag = 0.0;                           // RMS second difference away from fronts, / |sigma0|
+  double zigzag_early = 0.0;                         // its maximum over the first 5 L/c
+  double zigzag_late = 0.0;                          // its maximum over the last 5 L/c
+  double max_energy_error = 0.0;                     // |imbalance| / (sigma0 2 sigma0 L / E)
+  double front_error = 0.0;                          // |front - exact| at 0.5 L/c, in dx
   bool blew_up = false;
   double blow_up_time = 0.0;
   // histories (every few steps)
@@ -100,7 +100,8 @@ BarResult run_bar(const BarRun& r, const std::string& case_file, const std::vect
     }
     const double t = solver.time();
     for (std::size_t i = 0; i < nn; ++i) {
-      out.max_abs_stress = std::max(out.max_abs_stress, std::abs(solver.node_stress()(i, StressComponent::xx)) / kSigma0);
+      out.max_abs_stress =
+          std::max(out.max_abs_stress, std::abs(solver.node_stress()(i, StressComponent::xx)) / kSigma0);
     }
     if (!std::isfinite(out.max_abs_stress) || out.max_abs_stress > 1e6) {
       out.blew_up = true;
@@ -126,7 +127,8 @@ BarResult run_bar(const BarRun& r, const std::string& case_file, const std::vect
       for (std::size_t i = 1; i + 1 < nn; ++i) {
         if (exact.distance_to_front(nodes.position[i][0], t) <= 3.0 * dx) continue;
         const double s = solver.node_stress()(i, StressComponent::xx);
-        const double zz = s - 0.5 * (solver.node_stress()(i - 1, StressComponent::xx) + solver.node_stress()(i + 1, StressComponent::xx));
+        const double zz = s - 0.5 * (solver.node_stress()(i - 1, StressComponent::xx) +
+                                     solver.node_stress()(i + 1, StressComponent::xx));
         sum += zz * zz;
         ++count;
       }
@@ -205,7 +207,8 @@ CaseReport validate_case01(const Options& opt, const std::string& dir) {
     const BarResult res = run_bar(r, case_file, {0.5, 1.5, 3.5});
     e1.push_back(res.snapshot_e1.back());
     write_profiles(fmt::format("{}/smooth_N{}.csv", dir, ns[k]), res);
-    rep.metrics.push_back(metric(fmt::format("smooth load: e1(sigma) at 3.5 L/c, N = {}", ns[k]), e1.back(), "<=", tol[k], ""));
+    rep.metrics.push_back(
+        metric(fmt::format("smooth load: e1(sigma) at 3.5 L/c, N = {}", ns[k]), e1.back(), "<=", tol[k], ""));
   }
   rep.metrics.push_back(metric("smooth load: observed order, N = 200 -> 400", std::log2(e1[1] / e1[2]), ">=", 1.7, ""));
   rep.metrics.push_back(metric("smooth load: observed order, N = 100 -> 200", std::log2(e1[0] / e1[1]), "", 0.0, ""));
@@ -225,10 +228,11 @@ CaseReport validate_case01(const Options& opt, const std::string& dir) {
         worst_stress = std::max(worst_stress, res.max_abs_stress);
         worst_zigzag = std::max(worst_zigzag, res.max_zigzag);
         worst_growth = std::max(worst_growth, res.zigzag_late / std::max(res.zigzag_early, 1e-300));
-        rep.notes.push_back(fmt::format("step load {}, N = {}, C = {}: zig-zag RMS max {:.4f} (first 5 L/c {:.4f}, "
-                                        "last 5 L/c {:.4f}), max |sigma|/sigma0 {:.3f}, energy error {:.4f}",
-                                        sign > 0 ? "tension" : "compression", n, cfl, res.max_zigzag,
-                                        res.zigzag_early, res.zigzag_late, res.max_abs_stress, res.max_energy_error));
+        rep.notes.push_back(
+            fmt::format("step load {}, N = {}, C = {}: zig-zag RMS max {:.4f} (first 5 L/c {:.4f}, "
+                        "last 5 L/c {:.4f}), max |sigma|/sigma0 {:.3f}, energy error {:.4f}",
+                        sign > 0 ? "tension" : "compression", n, cfl, res.max_zigzag, res.zigzag_early, res.zigzag_late,
+                        res.max_abs_stress, res.max_energy_error));
         worst_energy = std::max(worst_energy, res.max_energy_error);
         worst_front = std::max(worst_front, res.front_error);
         if (sign > 0) {
@@ -251,8 +255,8 @@ CaseReport validate_case01(const Options& opt, const std::string& dir) {
           !(tension[1].snapshot_e1[s] < tension[0].snapshot_e1[s])) {
         decreasing = false;
       }
-      rep.notes.push_back(fmt::format("step load, C = {}: e1 at {} L/c is {:.4f} (N = 100) and {:.4f} (N = 400)",
-                                      cfl, snaps[s], tension[0].snapshot_e1[s], tension[1].snapshot_e1[s]));
+      rep.notes.push_back(fmt::format("step load, C = {}: e1 at {} L/c is {:.4f} (N = 100) and {:.4f} (N = 400)", cfl,
+                                      snaps[s], tension[0].snapshot_e1[s], tension[1].snapshot_e1[s]));
     }
   }
   rep.metrics.push_back(metric("step load: blow-up in any of the 8 runs (1 = yes)", blew ? 1.0 : 0.0, "<=", 0.0, ""));
@@ -270,10 +274,13 @@ CaseReport validate_case01(const Options& opt, const std::string& dir) {
     }
     rep.metrics.push_back(zig);
   }
-  rep.metrics.push_back(metric("step load: zig-zag growth, max over runs of (last 5 L/c) / (first 5 L/c)", worst_growth, "", 0.0, ""));
-  rep.metrics.push_back(metric("step load: max energy-balance error / (sigma0 2 sigma0 L/E)", worst_energy, "<=", 0.02, ""));
+  rep.metrics.push_back(
+      metric("step load: zig-zag growth, max over runs of (last 5 L/c) / (first 5 L/c)", worst_growth, "", 0.0, ""));
+  rep.metrics.push_back(
+      metric("step load: max energy-balance error / (sigma0 2 sigma0 L/E)", worst_energy, "<=", 0.02, ""));
   rep.metrics.push_back(metric("step load: front position error at 0.5 L/c", worst_front, "<=", 3.0, "dx"));
-  rep.metrics.push_back(metric("step load: e1 decreases with N at every snapshot (1 = yes)", decreasing ? 1.0 : 0.0, ">=", 1.0, ""));
+  rep.metrics.push_back(
+      metric("step load: e1 decreases with N at every snapshot (1 = yes)", decreasing ? 1.0 : 0.0, ">=", 1.0, ""));
   rep.metrics.push_back(metric("tension/compression mirror: max |s_t + s_c| / sigma0", mirror, "<=", 1e-9, ""));
 
   // ---- single-set (collocated) comparison, reported only (method-notes §0.3 item 6)
@@ -283,13 +290,17 @@ CaseReport validate_case01(const Options& opt, const std::string& dir) {
     BarRun step{100, 0.5, 1.0, false, true, 20.0 * kTransit};
     const BarResult st = run_bar(step, case_file, snaps);
     write_history(fmt::format("{}/collocated_step_tension_N100_C0.5.csv", dir), st);
-    rep.metrics.push_back(metric("single set (collocated), smooth load: e1 at 3.5 L/c, N = 100", s.snapshot_e1.empty() ? NAN : s.snapshot_e1.back(), "", 0, ""));
-    rep.metrics.push_back(metric("single set (collocated), step load: max |sigma|/|sigma0| over 20 L/c", st.max_abs_stress, "", 0, ""));
-    rep.metrics.push_back(metric("single set (collocated), step load: max energy error", st.max_energy_error, "", 0, ""));
-    rep.notes.push_back(st.blew_up ? fmt::format("the single-set run blew up at {:.2f} L/c", st.blow_up_time)
-                                   : "the single-set run stayed bounded over 20 L/c (fixed particles: the problem is linear, so "
-                                     "this compares time integration and boundary closure, not the tensile instability; "
-                                     "see method-notes §0.3 item 6)");
+    rep.metrics.push_back(metric("single set (collocated), smooth load: e1 at 3.5 L/c, N = 100",
+                                 s.snapshot_e1.empty() ? NAN : s.snapshot_e1.back(), "", 0, ""));
+    rep.metrics.push_back(
+        metric("single set (collocated), step load: max |sigma|/|sigma0| over 20 L/c", st.max_abs_stress, "", 0, ""));
+    rep.metrics.push_back(
+        metric("single set (collocated), step load: max energy error", st.max_energy_error, "", 0, ""));
+    rep.notes.push_back(
+        st.blew_up ? fmt::format("the single-set run blew up at {:.2f} L/c", st.blow_up_time)
+                   : "the single-set run stayed bounded over 20 L/c (fixed particles: the problem is linear, so "
+                     "this compares time integration and boundary closure, not the tensile instability; "
+                     "see method-notes §0.3 item 6)");
   }
   std::string note;
   if (opt.plots && run_plot_script("plot_case01.py", dir, note)) {

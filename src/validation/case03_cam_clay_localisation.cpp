@@ -48,9 +48,9 @@ struct Snapshot {
 struct SampleResult {
   double dx = 0.0;
   std::vector<double> strain, q, p, cov, eps_mean, q_platen;  // histories
-  double cov_at_09 = NAN;       // CoV of q over nodes when the average q first reaches 0.9 q_y
+  double cov_at_09 = NAN;  // CoV of q over nodes when the average q first reaches 0.9 q_y
   double q_peak = 0.0, strain_peak = 0.0, q_end = 0.0, q_at_6 = NAN;
-  double slope = NAN;           // fitted dq/d eps_a for 0.2 q_y <= q <= 0.8 q_y
+  double slope = NAN;  // fitted dq/d eps_a for 0.2 q_y <= q <= 0.8 q_y
   std::vector<Snapshot> snaps;
   double band_angle = NAN, band_offset = NAN;  // degrees; distance of the band axis from the imperfection, m
   double band_angle_whole = NAN, band_angle_upper = NAN, band_angle_lower = NAN;  // degrees
@@ -185,7 +185,8 @@ void write_history(const std::string& file, const SampleResult& r) {
   std::ofstream f(file);
   f << "strain,q,p,eps_vp_eq_mean,q_platen\n";
   for (std::size_t k = 0; k < r.strain.size(); ++k) {
-    f << fmt::format("{:.8g},{:.10g},{:.10g},{:.8g},{:.10g}\n", r.strain[k], r.q[k], r.p[k], r.eps_mean[k], r.q_platen[k]);
+    f << fmt::format("{:.8g},{:.10g},{:.10g},{:.8g},{:.10g}\n", r.strain[k], r.q[k], r.p[k], r.eps_mean[k],
+                     r.q_platen[k]);
   }
 }
 
@@ -206,8 +207,9 @@ CaseReport validate_case03(const Options& opt, const std::string& dir) {
   CaseReport rep;
   rep.id = "03";
   rep.title = "2D Cam-Clay plane-strain compression, strain localisation (V1)";
-  rep.reference = "closed-form elastic path and first yield of docs/cases.md Case 3 (constant M), "
-                  "band-angle bounds 43-68 deg";
+  rep.reference =
+      "closed-form elastic path and first yield of docs/cases.md Case 3 (constant M), "
+      "band-angle bounds 43-68 deg";
   const std::string case_file = (fs::path(opt.cases_dir) / "03_cam_clay_localisation_2d.toml").string();
   const ElasticPath path;
   const double s_y = path.yield_s();
@@ -220,9 +222,10 @@ CaseReport validate_case03(const Options& opt, const std::string& dir) {
       f << fmt::format("{:.8g},{:.10g},{:.10g}\n", path.strain(s), path.q(s), path.p(s));
     }
   }
-  rep.notes.push_back(fmt::format("closed form: s_y = {:.1f} kPa, q_y = {:.1f} kPa, p'_y = {:.1f} kPa, eps_a,y = {:.3f} %, "
-                                  "elastic slope dq/deps_a = {:.4g} MPa",
-                                  s_y / 1e3, q_y / 1e3, path.p(s_y) / 1e3, 100 * eps_y, path.slope() / 1e6));
+  rep.notes.push_back(
+      fmt::format("closed form: s_y = {:.1f} kPa, q_y = {:.1f} kPa, p'_y = {:.1f} kPa, eps_a,y = {:.3f} %, "
+                  "elastic slope dq/deps_a = {:.4g} MPa",
+                  s_y / 1e3, q_y / 1e3, path.p(s_y) / 1e3, 100 * eps_y, path.slope() / 1e6));
 
   // --quick: dx = 0.04 m (25 x 50); --full: docs/cases.md dx = 0.02 m and the refinement 0.01 m.
   const double dx = opt.full ? 0.02 : 0.04;
@@ -236,10 +239,11 @@ CaseReport validate_case03(const Options& opt, const std::string& dir) {
     std::ofstream f(fs::path(dir) / "plot_input.txt");
     f << fmt::format("{}\n", dx);
   }
-  rep.notes.push_back(fmt::format("resolution dx = {} m ({}), {} steps, RK4 sub-steps max {}; q and p' are those of "
-                                  "the volume-averaged nodal stress tensor",
-                                  dx, opt.full ? "docs/cases.md" : "quick mode; --full runs docs/cases.md's 0.02 m and 0.01 m",
-                                  r.steps, r.max_substeps));
+  rep.notes.push_back(
+      fmt::format("resolution dx = {} m ({}), {} steps, RK4 sub-steps max {}; q and p' are those of "
+                  "the volume-averaged nodal stress tensor",
+                  dx, opt.full ? "docs/cases.md" : "quick mode; --full runs docs/cases.md's 0.02 m and 0.01 m", r.steps,
+                  r.max_substeps));
 
   rep.metrics.push_back(metric("CoV of q over particles when average q = 0.9 q_y", r.cov_at_09, "<=", 0.03, ""));
   rep.metrics.push_back(metric("pre-peak slope dq/deps_a (0.2-0.8 q_y), relative error vs closed form",
@@ -249,39 +253,47 @@ CaseReport validate_case03(const Options& opt, const std::string& dir) {
   rep.metrics.push_back(metric("peak q / q_y - 1 (lower bound -1 %)", dq, ">=", -0.01, ""));
   rep.metrics.push_back(metric("peak q (q_y = 236.3 kPa)", r.q_peak / 1e3, "", 0, "kPa"));
   {
-    Metric m = metric("axial strain at peak / eps_a,y - 1 (|.| <= 10 %)", std::abs(r.strain_peak / eps_y - 1.0), "<=", 0.10, "");
+    Metric m = metric("axial strain at peak / eps_a,y - 1 (|.| <= 10 %)", std::abs(r.strain_peak / eps_y - 1.0),
+                      "<=", 0.10, "");
     rep.metrics.push_back(m);
   }
   rep.metrics.push_back(metric("axial strain at peak (eps_a,y = 1.21 %)", 100 * r.strain_peak, "", 0, "%"));
-  rep.metrics.push_back(metric("softening: q " + fmt::format("at {:.0f} %", 100 * end_strain) + " / peak q", r.q_end / r.q_peak, "<=", 0.99, ""));
+  rep.metrics.push_back(metric("softening: q " + fmt::format("at {:.0f} %", 100 * end_strain) + " / peak q",
+                               r.q_end / r.q_peak, "<=", 0.99, ""));
   const std::string at_end = fmt::format("at {:.0f} %", 100 * end_strain);
-  rep.metrics.push_back(metric("band angle to the horizontal " + at_end + " (lower bound)", r.band_angle, ">=", 43.0, "deg"));
-  rep.metrics.push_back(metric("band angle to the horizontal " + at_end + " (upper bound)", r.band_angle, "<=", 68.0, "deg"));
+  rep.metrics.push_back(
+      metric("band angle to the horizontal " + at_end + " (lower bound)", r.band_angle, ">=", 43.0, "deg"));
+  rep.metrics.push_back(
+      metric("band angle to the horizontal " + at_end + " (upper bound)", r.band_angle, "<=", 68.0, "deg"));
   rep.metrics.push_back(metric("band: upper arm angle", r.band_angle_upper, "", 0, "deg"));
   rep.metrics.push_back(metric("band: lower arm angle", r.band_angle_lower, "", 0, "deg"));
   rep.metrics.push_back(metric("band: whole-cloud principal axis angle", r.band_angle_whole, "", 0, "deg"));
-  rep.notes.push_back(r.pair ? "the band is a conjugate pair from the imperfection; its angle is the mean of the two arms' "
-                               "principal axes (docs/cases.md §1.3 applied arm by arm)"
-                             : "the band is a single band; its angle is the principal axis of the thresholded cloud");
+  rep.notes.push_back(
+      r.pair ? "the band is a conjugate pair from the imperfection; its angle is the mean of the two arms' "
+               "principal axes (docs/cases.md §1.3 applied arm by arm)"
+             : "the band is a single band; its angle is the principal axis of the thresholded cloud");
   rep.metrics.push_back(metric("distance of the band axis from the imperfection centre", r.band_offset, "", 0, "m"));
   rep.metrics.push_back(metric("particles in the band (eps >= 50 % max)", r.band_particles, "", 0, ""));
   if (opt.full) rep.metrics.push_back(metric("average q at 6 % strain", r.q_at_6 / 1e3, "", 0, "kPa"));
   if (r.band_particles < 30) {
-    rep.notes.push_back(fmt::format("band angle from only {} particles: at this resolution and strain the 50 % cloud is "
-                                    "the imperfection zone rather than a developed band; read the maps",
-                                    r.band_particles));
+    rep.notes.push_back(
+        fmt::format("band angle from only {} particles: at this resolution and strain the 50 % cloud is "
+                    "the imperfection zone rather than a developed band; read the maps",
+                    r.band_particles));
   }
   if (opt.full) {
     const SampleResult f = run_sample(case_file, 0.01, 0.08, {0.08}, q_y);
     write_history(fmt::format("{}/history_dx{}.csv", dir, 0.01), f);
     write_snapshots(fmt::format("{}/snapshots_dx{}.csv", dir, 0.01), f);
-    rep.metrics.push_back(metric("refinement dx 0.02 -> 0.01: band angle change", std::abs(f.band_angle - r.band_angle), "<=", 5.0, "deg"));
+    rep.metrics.push_back(metric("refinement dx 0.02 -> 0.01: band angle change", std::abs(f.band_angle - r.band_angle),
+                                 "<=", 5.0, "deg"));
     rep.metrics.push_back(metric("refinement dx 0.02 -> 0.01: relative change of q at 6 %",
                                  std::abs(f.q_at_6 / r.q_at_6 - 1.0), "<=", 0.10, ""));
-    rep.notes.push_back(fmt::format("dx = 0.01: peak q {:.1f} kPa at {:.3f} %, band angle {:.1f} deg (arms {:.1f} / {:.1f}, "
-                                    "whole cloud {:.1f}), q(6 %) {:.1f} kPa",
-                                    f.q_peak / 1e3, 100 * f.strain_peak, f.band_angle, f.band_angle_upper,
-                                    f.band_angle_lower, f.band_angle_whole, f.q_at_6 / 1e3));
+    rep.notes.push_back(
+        fmt::format("dx = 0.01: peak q {:.1f} kPa at {:.3f} %, band angle {:.1f} deg (arms {:.1f} / {:.1f}, "
+                    "whole cloud {:.1f}), q(6 %) {:.1f} kPa",
+                    f.q_peak / 1e3, 100 * f.strain_peak, f.band_angle, f.band_angle_upper, f.band_angle_lower,
+                    f.band_angle_whole, f.q_at_6 / 1e3));
   }
   std::string note;
   if (opt.plots && run_plot_script("plot_case03.py", dir, note)) {

@@ -32,11 +32,11 @@ constexpr RefPoint kRefPoints[] = {
 };
 
 struct CaseA {
-  double stress_err = 0.0;    // max |sigma - ref| / (rho g H) over the points and components
-  double disp_err = 0.0;      // max relative displacement error
+  double stress_err = 0.0;         // max |sigma - ref| / (rho g H) over the points and components
+  double disp_err = 0.0;           // max relative displacement error
   double crest_err_relaxed = 0.0;  // crest u_x error at t = 1.2 s (just relaxed)
   double crest_drift = 0.0;        // d u_c / dt over the last 0.5 s, m/s
-  double section_err = 0.0;   // max relative section-resultant error
+  double section_err = 0.0;        // max relative section-resultant error
   double face_res = 0.0, top_res = 0.0, face_res_above = 0.0;  // / (rho g H)
   // Well-posed face measures under the toe singularity (scripts/williams_corner.py), / (rho g H):
   // RMS over the face, max over y >= 2 dx, and the toe row (the stress-point row y = dx/2).
@@ -187,8 +187,14 @@ CaseB run_b(const std::string& file, double dx, const std::string& dir) {
         for (std::size_t i = 0; i < nn; ++i) {
           const auto& p = nodes.position[i];
           const double db = std::hypot(p[0] - xs[k], p[1]), dt_ = std::hypot(p[0] - xs[k], p[1] - kH);
-          if (db < d0 - 1e-9) { d0 = db; base[static_cast<std::size_t>(k)] = i; }
-          if (dt_ < d1 - 1e-9) { d1 = dt_; top[static_cast<std::size_t>(k)] = i; }
+          if (db < d0 - 1e-9) {
+            d0 = db;
+            base[static_cast<std::size_t>(k)] = i;
+          }
+          if (dt_ < d1 - 1e-9) {
+            d1 = dt_;
+            top[static_cast<std::size_t>(k)] = i;
+          }
         }
       }
       for (std::size_t i = 0; i < nn; ++i) {
@@ -243,14 +249,16 @@ CaseReport validate_case04(const Options& opt, const std::string& dir) {
   CaseReport rep;
   rep.id = "04";
   rep.title = "Elastic vertical cut (V1)";
-  rep.reference = "docs/cases.md Case 4: (a) 9-node FE reference points and exact equilibrium checks; "
-                  "(b) closed form of the nu = 0 block under sudden gravity";
+  rep.reference =
+      "docs/cases.md Case 4: (a) 9-node FE reference points and exact equilibrium checks; "
+      "(b) closed form of the nu = 0 block under sudden gravity";
   const std::string file_a = (fs::path(opt.cases_dir) / "04a_elastic_cut_2d.toml").string();
   const std::string file_b = (fs::path(opt.cases_dir) / "04b_elastic_cut_closed_form_2d.toml").string();
 
   // (a) at docs/cases.md's dx = 0.5 m and the repeat at 0.25 m (both cheap: run in both modes); full
   // mode adds 0.125 m with every figure reported only (the refinement study of the toe corner).
-  const std::vector<double> spacings_a = opt.full ? std::vector<double>{0.5, 0.25, 0.125} : std::vector<double>{0.5, 0.25};
+  const std::vector<double> spacings_a =
+      opt.full ? std::vector<double>{0.5, 0.25, 0.125} : std::vector<double>{0.5, 0.25};
   for (double dx : spacings_a) {
     const CaseA a = run_a(file_a, dx, dir, rep.notes);
     const std::size_t first_metric = rep.metrics.size();
@@ -261,14 +269,16 @@ CaseReport validate_case04(const Options& opt, const std::string& dir) {
     if (!disp.pass() && a.crest_err_relaxed <= 0.05) {
       disp.known_deviation = fmt::format(
           "the crest u_x does not stay put: after the relaxation it drifts at {:.2g} m/s, driven by the steady flow at "
-          "the toe (method-notes §0.3 item 8, a forced nodal checkerboard whose kinetic energy scales as 1/eps^2 with the "
+          "the toe (method-notes §0.3 item 8, a forced nodal checkerboard whose kinetic energy scales as 1/eps^2 with "
+          "the "
           "filter strength); at t = 1.2 s, just relaxed, its error is {:.1f} %, inside 5 %",
           a.crest_drift, 100.0 * a.crest_err_relaxed);
     }
     rep.metrics.push_back(disp);
-    rep.metrics.push_back(metric(tag + "crest u_x drift over the last 0.5 s (steady toe flow)", a.crest_drift, "", 0.0, "m/s"));
-    rep.metrics.push_back(metric(tag + "section resultant error, max over node rows y < H, relative", a.section_err,
-                                 "<=", 0.01, ""));
+    rep.metrics.push_back(
+        metric(tag + "crest u_x drift over the last 0.5 s (steady toe flow)", a.crest_drift, "", 0.0, "m/s"));
+    rep.metrics.push_back(
+        metric(tag + "section resultant error, max over node rows y < H, relative", a.section_err, "<=", 0.01, ""));
     Metric face = metric(tag + "traction residual on the face (stress points extrapolated) / rho g H", a.face_res,
                          "<=", 0.02, "");
     if (!face.pass() && a.face_res_above <= 0.02) {
@@ -278,24 +288,29 @@ CaseReport validate_case04(const Options& opt, const std::string& dir) {
           "right angle at nu = 0.3, scripts/williams_corner.py; it does not fall with refinement: 9.0 % at dx = 0.5 m, "
           "10.7 % at 0.25 m), so no extrapolation from the stress points vanishes there, and the steady toe flow of "
           "method-notes §0.3 item 8 lives in those rows; for y >= 0.1 H it is "
-          "{:.2g} %, inside 2 %", 100.0 * a.face_res_above);
+          "{:.2g} %, inside 2 %",
+          100.0 * a.face_res_above);
     }
     rep.metrics.push_back(face);
-    rep.metrics.push_back(metric(tag + "traction residual on the face for y >= 0.1 H (away from the toe corner) / rho g H",
-                                 a.face_res_above, "", 0.0, ""));
-    rep.metrics.push_back(metric(tag + "traction residual on the face for y >= 2 dx (all but the two toe rows) / rho g H",
-                                 a.face_res_2dx, "", 0.0, ""));
-    rep.metrics.push_back(metric(tag + "traction residual on the face, RMS over the rows of sqrt(s_n^2 + s_t^2) / rho g H",
-                                 a.face_rms, "", 0.0, ""));
-    rep.metrics.push_back(metric(tag + "traction residual on the face in the toe row y = dx/2 / rho g H", a.face_toe_row, "",
-                                 0.0, ""));
-    rep.metrics.push_back(metric(tag + "traction residual on the top (stress points extrapolated) / rho g H",
-                                 a.top_res, "<=", 0.02, ""));
+    rep.metrics.push_back(
+        metric(tag + "traction residual on the face for y >= 0.1 H (away from the toe corner) / rho g H",
+               a.face_res_above, "", 0.0, ""));
+    rep.metrics.push_back(
+        metric(tag + "traction residual on the face for y >= 2 dx (all but the two toe rows) / rho g H", a.face_res_2dx,
+               "", 0.0, ""));
+    rep.metrics.push_back(
+        metric(tag + "traction residual on the face, RMS over the rows of sqrt(s_n^2 + s_t^2) / rho g H", a.face_rms,
+               "", 0.0, ""));
+    rep.metrics.push_back(
+        metric(tag + "traction residual on the face in the toe row y = dx/2 / rho g H", a.face_toe_row, "", 0.0, ""));
+    rep.metrics.push_back(
+        metric(tag + "traction residual on the top (stress points extrapolated) / rho g H", a.top_res, "<=", 0.02, ""));
     rep.metrics.push_back(metric(tag + "kinetic energy at t = 2 s / its peak (method-notes §0.3 item 8)",
                                  a.ke_peak > 0 ? a.ke_end / a.ke_peak : NAN, "", 0.0, ""));
-    rep.notes.push_back(fmt::format("(a) dx = {} m: {} steps, {:.1f} s; at t = 2 s kinetic energy {:.3g} J/m (peak "
-                                    "{:.3g}), largest |v| = {:.3g} m/s at ({}, {}) m",
-                                    dx, a.steps, a.seconds, a.ke_end, a.ke_peak, a.vmax_end, a.vmax_x, a.vmax_y));
+    rep.notes.push_back(
+        fmt::format("(a) dx = {} m: {} steps, {:.1f} s; at t = 2 s kinetic energy {:.3g} J/m (peak "
+                    "{:.3g}), largest |v| = {:.3g} m/s at ({}, {}) m",
+                    dx, a.steps, a.seconds, a.ke_end, a.ke_peak, a.vmax_end, a.vmax_x, a.vmax_y));
     {
       std::string rows;
       for (std::size_t k = 0; k < std::min<std::size_t>(4, a.face_rows.size()); ++k) {
@@ -303,9 +318,10 @@ CaseReport validate_case04(const Options& opt, const std::string& dir) {
         rows += fmt::format("{}y = {} m: s_n {:.2f} %, s_t {:.2f} %", k ? "; " : "", fr.y, 100.0 * fr.sn / kGammaH,
                             100.0 * fr.st / kGammaH);
       }
-      rep.notes.push_back(fmt::format("(a) dx = {} m: face tractions extrapolated from the stress points, toe rows "
-                                      "(/ rho g H): {} (all rows in a_face_residual_dx{}.csv)",
-                                      dx, rows, dx));
+      rep.notes.push_back(
+          fmt::format("(a) dx = {} m: face tractions extrapolated from the stress points, toe rows "
+                      "(/ rho g H): {} (all rows in a_face_residual_dx{}.csv)",
+                      dx, rows, dx));
     }
     if (dx < 0.2) {  // the refinement run: figures reported, nothing judged
       for (std::size_t k = first_metric; k < rep.metrics.size(); ++k) {
@@ -314,8 +330,9 @@ CaseReport validate_case04(const Options& opt, const std::string& dir) {
       }
     }
   }
-  rep.notes.push_back("(a) particles do not move in V1, so the tensile-instability clumping at the top corner "
-                      "cannot occur (method-notes §0.3 item 6); the stress at the crest node is in a_final_dx*.csv");
+  rep.notes.push_back(
+      "(a) particles do not move in V1, so the tensile-instability clumping at the top corner "
+      "cannot occur (method-notes §0.3 item 6); the stress at the crest node is in a_final_dx*.csv");
 
   // (b) over two periods at 0.5, 0.25 and the acceptance resolution 0.125 m.
   for (double dx : {0.5, 0.25, 0.125}) {
@@ -323,23 +340,23 @@ CaseReport validate_case04(const Options& opt, const std::string& dir) {
     const bool accept = dx < 0.2;
     const std::string tag = fmt::format("(b) dx = {} m: ", dx);
     rep.metrics.push_back(metric(tag + "base sigma_yy error / (2 rho g H), max over x = 1, 5, 9.75 m and t (±2 steps "
-                                 "of the reversals excluded)",
+                                       "of the reversals excluded)",
                                  b.base_err, accept ? "<=" : "", 0.03, ""));
     rep.metrics.push_back(metric(tag + "top u_y error / (rho g H^2/E), max over x = 1, 5, 9.75 m and t", b.top_err,
                                  accept ? "<=" : "", 0.03, ""));
     rep.metrics.push_back(metric(tag + "spurious face u_x / max|u_y|", b.ux_ratio, accept ? "<=" : "", 0.02, ""));
     rep.metrics.push_back(metric(tag + "sigma_yy spread across x at y = 0, 2.5, 5, 7.5 m / rho g H", b.uniformity,
                                  accept ? "<=" : "", 0.03, ""));
-    rep.notes.push_back(fmt::format("(b) dx = {} m: {} steps, {:.1f} s{}", dx, b.steps, b.seconds,
-                                    dx > 0.4 ? " (x = 9.75 m is not a node at this spacing: the nearest node is used)"
-                                             : ""));
+    rep.notes.push_back(
+        fmt::format("(b) dx = {} m: {} steps, {:.1f} s{}", dx, b.steps, b.seconds,
+                    dx > 0.4 ? " (x = 9.75 m is not a node at this spacing: the nearest node is used)" : ""));
   }
   if (opt.plots) {
     std::string note;
     if (run_plot_script("plot_case04.py", dir, note)) {
-      for (const char* p : {"case04/a_stress_profiles.png", "case04/a_sections.png", "case04/a_deformed.png",
-                            "case04/b_base_stress.png", "case04/b_top_uy.png", "case04/b_face_ux.png",
-                            "case04/a_face_residual.png"}) {
+      for (const char* p :
+           {"case04/a_stress_profiles.png", "case04/a_sections.png", "case04/a_deformed.png",
+            "case04/b_base_stress.png", "case04/b_top_uy.png", "case04/b_face_ux.png", "case04/a_face_residual.png"}) {
         rep.plots.push_back(p);
       }
     } else {

@@ -33,8 +33,9 @@ CaseReport validate_case05(const Options& opt, const std::string& dir) {
   CaseReport rep;
   rep.id = "05";
   rep.title = "Viscoplastic vertical cut without softening (V1)";
-  rep.reference = "docs/cases.md Case 5: limit analysis of a vertical cut in a Tresca material, N_c = gamma H/c ~ 3.78 "
-                  "(bracket 2.83-4.00); circular mechanism emerging 0.91H behind the crest";
+  rep.reference =
+      "docs/cases.md Case 5: limit analysis of a vertical cut in a Tresca material, N_c = gamma H/c ~ 3.78 "
+      "(bracket 2.83-4.00); circular mechanism emerging 0.91H behind the crest";
   const std::string file = (fs::path(opt.cases_dir) / "05_viscoplastic_cut_2d.toml").string();
   const std::vector<double> spacings = opt.full ? std::vector<double>{0.25, 0.125} : std::vector<double>{0.5};
   constexpr double kH = 10.0, kW = 20.0;
@@ -57,16 +58,18 @@ CaseReport validate_case05(const Options& opt, const std::string& dir) {
       const double toe = band_distance_to(s, kW, 0.0, 0.0);
       const double emerge = emergence_behind_crest(s, dx, kW, kH);
       rep.metrics.push_back(metric(tag + "N = 4.2: distance of the failure surface (eps_vp_eq >= 50 % of max) from "
-                                   "the toe",
+                                         "the toe",
                                    toe, "<=", 3.0 * dx, "m"));
-      rep.metrics.push_back(metric(tag + "N = 4.2: emergence on the top behind the crest, >= 0.7 H", emerge, ">=",
-                                   0.7 * kH, "m"));
-      rep.metrics.push_back(metric(tag + "N = 4.2: emergence on the top behind the crest, <= 1.15 H", emerge, "<=",
-                                   1.15 * kH, "m"));
-      std::ofstream(fs::path(dir) / "meta.csv") << "dx,H,W,emergence\n" << fmt::format("{},{},{},{}\n", dx, kH, kW, emerge);
+      rep.metrics.push_back(
+          metric(tag + "N = 4.2: emergence on the top behind the crest, >= 0.7 H", emerge, ">=", 0.7 * kH, "m"));
+      rep.metrics.push_back(
+          metric(tag + "N = 4.2: emergence on the top behind the crest, <= 1.15 H", emerge, "<=", 1.15 * kH, "m"));
+      std::ofstream(fs::path(dir) / "meta.csv") << "dx,H,W,emergence\n"
+                                                << fmt::format("{},{},{},{}\n", dx, kH, kW, emerge);
     }
   }
-  if (!opt.full) rep.notes.push_back("quick mode: dx = 0.5 m; --full runs docs/cases.md's 0.25 m and the refinement 0.125 m");
+  if (!opt.full)
+    rep.notes.push_back("quick mode: dx = 0.5 m; --full runs docs/cases.md's 0.25 m and the refinement 0.125 m");
   if (opt.plots) {
     std::string note;
     if (run_plot_script("plot_case05.py", dir, note)) {

@@ -42,8 +42,9 @@ CaseReport validate_case06(const Options& opt, const std::string& dir) {
   CaseReport rep;
   rep.id = "06";
   rep.title = "Viscoplastic vertical cut with softening (V1)";
-  rep.reference = "docs/cases.md Case 6: strength between residual and peak: N0 = 2.2 must stand (residual limit "
-                  "2.27), N0 = 3.9 must collapse (peak limit 3.78); band-width objectivity";
+  rep.reference =
+      "docs/cases.md Case 6: strength between residual and peak: N0 = 2.2 must stand (residual limit "
+      "2.27), N0 = 3.9 must collapse (peak limit 3.78); band-width objectivity";
   const std::string file = (fs::path(opt.cases_dir) / "06_softening_cut_2d.toml").string();
   const std::string file5 = (fs::path(opt.cases_dir) / "05_viscoplastic_cut_2d.toml").string();
   const std::vector<double> spacings = opt.full ? std::vector<double>{0.25, 0.125} : std::vector<double>{0.5, 0.25};
@@ -74,29 +75,31 @@ CaseReport validate_case06(const Options& opt, const std::string& dir) {
     const CutSnapshot& w39 = s39.has_collapse_state ? s39.at_collapse : s39.final_state;
     const double w = band_width(w39, dx, (fs::path(dir) / fmt::format("profile_N3.9_dx{}.csv", dx)).string());
     widths.push_back(w);
-    rep.metrics.push_back(metric(tag + "N0 = 3.9: band width (FWHM of eps_vp_eq along y = H/2 when u_c first exceeds 0.05 H)", w, "", 0.0, "m"));
+    rep.metrics.push_back(metric(
+        tag + "N0 = 3.9: band width (FWHM of eps_vp_eq along y = H/2 when u_c first exceeds 0.05 H)", w, "", 0.0, "m"));
     rep.metrics.push_back(metric(tag + "N0 = 3.9: distance of the band (eps_vp_eq >= 50 % of max) from the toe",
                                  band_distance_to(s39.final_state, kW, 0.0, 0.0), "<=", 3.0 * dx, "m"));
     if (first) {
       // Case 5 at N = 4.2, same dx (cached if case 5 ran in this process).
-      const CutRun c5 = run_cut(file5, {fmt::format("geometry.spacing={}", dx), "output.interval=0",
-                                        "material.cohesion=46710"},
-                                0.01, 0.1);
+      const CutRun c5 = run_cut(
+          file5, {fmt::format("geometry.spacing={}", dx), "output.interval=0", "material.cohesion=46710"}, 0.01, 0.1);
       write_history_csv((fs::path(dir) / fmt::format("history_case5_N3.4_dx{}.csv", dx)).string(),
                         run_cut(file5, {fmt::format("geometry.spacing={}", dx), "output.interval=0"}, 0.01, 0.1));
-      const double w5 = band_width(c5.has_collapse_state ? c5.at_collapse : c5.final_state, dx, (fs::path(dir) / fmt::format("profile_case5_N4.2_dx{}.csv", dx)).string());
+      const double w5 = band_width(c5.has_collapse_state ? c5.at_collapse : c5.final_state, dx,
+                                   (fs::path(dir) / fmt::format("profile_case5_N4.2_dx{}.csv", dx)).string());
       rep.metrics.push_back(metric(tag + "band width N0 = 3.9 / plastic-zone width of case 5 N = 4.2 (narrower: < 1)",
                                    w / w5, "<=", 1.0, ""));
     }
   }
   if (widths.size() == 2) {
-    rep.metrics.push_back(metric(fmt::format("band width change when dx is halved ({} -> {} m), relative",
-                                             spacings[0], spacings[1]),
-                                 std::abs(widths[1] - widths[0]) / widths[0], "<=", 0.25, ""));
+    rep.metrics.push_back(
+        metric(fmt::format("band width change when dx is halved ({} -> {} m), relative", spacings[0], spacings[1]),
+               std::abs(widths[1] - widths[0]) / widths[0], "<=", 0.25, ""));
   }
   if (!opt.full) {
-    rep.notes.push_back("quick mode: the three runs at dx = 0.5 m and N0 = 3.9 also at 0.25 m; --full runs docs/cases.md's "
-                        "0.25 m and 0.125 m");
+    rep.notes.push_back(
+        "quick mode: the three runs at dx = 0.5 m and N0 = 3.9 also at 0.25 m; --full runs docs/cases.md's "
+        "0.25 m and 0.125 m");
   }
   if (opt.plots) {
     std::string note;

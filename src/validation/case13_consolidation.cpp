@@ -36,9 +36,9 @@ analytic::SaturatedColumn column13() {
 
 struct ColumnRun {
   double dx = 0.0;
-  std::vector<double> depth;                  // z = H - x of each node, sorted by depth
-  std::vector<std::vector<double>> iso;       // p_w/p0 at each tabulated time (per node)
-  std::vector<double> iso_time;               // actual solver time of each isochrone
+  std::vector<double> depth;                        // z = H - x of each node, sorted by depth
+  std::vector<std::vector<double>> iso;             // p_w/p0 at each tabulated time (per node)
+  std::vector<double> iso_time;                     // actual solver time of each isochrone
   std::vector<double> t, u_h, s_h, p25, p50, p100;  // histories
   double einf[5] = {}, e2_num = 0.0, e2_den = 0.0;
   double e2_late_num = 0.0, e2_late_den = 0.0;  // isochrones T_v >= 0.2 only
@@ -62,7 +62,8 @@ ColumnRun run_column(const std::string& case_file, double dx) {
   const auto nn = static_cast<std::size_t>(nodes.size());
   std::vector<std::size_t> order(nn);
   for (std::size_t i = 0; i < nn; ++i) order[i] = i;
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return nodes.position[a][0] > nodes.position[b][0]; });
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return nodes.position[a][0] > nodes.position[b][0]; });
   ColumnRun out;
   out.dx = dx;
   for (std::size_t i : order) out.depth.push_back(kH - nodes.position[i][0]);
@@ -173,9 +174,10 @@ CaseReport validate_case13(const Options& opt, const std::string& dir) {
   CaseReport rep;
   rep.id = "13";
   rep.title = "Consolidation of a saturated soil column (V3)";
-  rep.reference = "Terzaghi series with Biot's c_v = 3.089 m^2/s and p0 = q Q/(M+Q) = 4.545 kPa "
-                  "(docs/cases.md Case 13), convolved exactly with the 0.5 s load ramp "
-                  "(src/validation/analytic_saturated.hpp)";
+  rep.reference =
+      "Terzaghi series with Biot's c_v = 3.089 m^2/s and p0 = q Q/(M+Q) = 4.545 kPa "
+      "(docs/cases.md Case 13), convolved exactly with the 0.5 s load ramp "
+      "(src/validation/analytic_saturated.hpp)";
   const std::string case_file = (fs::path(opt.cases_dir) / "13_consolidation_column.toml").string();
   const analytic::Terzaghi ref{column13(), kQ, kRamp};
   std::vector<double> spacings = {0.2, 0.1};
@@ -193,8 +195,8 @@ CaseReport validate_case13(const Options& opt, const std::string& dir) {
   }
   rep.metrics.push_back(metric("dx = 0.1: max |U_h - U| over t in [1, 40] s", b.u_err, "<=", 0.02, ""));
   rep.metrics.push_back(metric("dx = 0.1: max |S_h - S| / S_inf over the run", b.s_err, "<=", 0.03, ""));
-  rep.metrics.push_back(metric("dx = 0.1: checkerboard, max |p_I - mean of neighbours| / p0 (below 3 dx)", b.checker,
-                               "<=", 0.01, ""));
+  rep.metrics.push_back(
+      metric("dx = 0.1: checkerboard, max |p_I - mean of neighbours| / p0 (below 3 dx)", b.checker, "<=", 0.01, ""));
   std::string conv;
   for (std::size_t k = 0; k < runs.size(); ++k) {
     const double e2 = std::sqrt(runs[k].e2_num / runs[k].e2_den);
@@ -202,10 +204,12 @@ CaseReport validate_case13(const Options& opt, const std::string& dir) {
     rep.metrics.push_back(metric(fmt::format("dx = {}: e2 over the five isochrones", runs[k].dx), e2, "", 0, ""));
   }
   for (std::size_t k = 0; k + 1 < runs.size(); ++k) {
-    const double ec = std::sqrt(runs[k].e2_num / runs[k].e2_den), ef = std::sqrt(runs[k + 1].e2_num / runs[k + 1].e2_den);
+    const double ec = std::sqrt(runs[k].e2_num / runs[k].e2_den),
+                 ef = std::sqrt(runs[k + 1].e2_num / runs[k + 1].e2_den);
     const double order = std::log(ec / ef) / std::log(runs[k].dx / runs[k + 1].dx);
-    Metric m = metric(fmt::format("observed order of e2 (all five isochrones), dx {} -> {}", runs[k].dx, runs[k + 1].dx),
-                      order, ">=", 1.0, "");
+    Metric m =
+        metric(fmt::format("observed order of e2 (all five isochrones), dx {} -> {}", runs[k].dx, runs[k + 1].dx),
+               order, ">=", 1.0, "");
     m.known_deviation =
         "the T_v = 0.05 and 0.1 isochrones (t = 1.6 and 3.2 s) are snapshots of the undrained free vibration that the "
         "0.5 s linear load ramp excites (first-mode shape, period about 4H/V_c = 0.086 s, amplitude +-1.5 % p0 at "
@@ -214,19 +218,22 @@ CaseReport validate_case13(const Options& opt, const std::string& dir) {
         "reference - and the time integration damps it less as dx and dt shrink, so this deviation grows towards the "
         "dynamic solution instead of converging to the quasi-static one. The order over T_v >= 0.2, where it has "
         "decayed, is the next metric";
-    if (!m.pass()) rep.metrics.push_back(m);
-    else rep.metrics.push_back(metric(m.name, order, ">=", 1.0, ""));
+    if (!m.pass())
+      rep.metrics.push_back(m);
+    else
+      rep.metrics.push_back(metric(m.name, order, ">=", 1.0, ""));
     const double lc = std::sqrt(runs[k].e2_late_num / runs[k].e2_late_den);
     const double lf = std::sqrt(runs[k + 1].e2_late_num / runs[k + 1].e2_late_den);
-    rep.metrics.push_back(metric(fmt::format("observed order of e2 over the isochrones T_v >= 0.2, dx {} -> {}",
-                                             runs[k].dx, runs[k + 1].dx),
-                                 std::log(lc / lf) / std::log(runs[k].dx / runs[k + 1].dx), ">=", 1.0, ""));
+    rep.metrics.push_back(metric(
+        fmt::format("observed order of e2 over the isochrones T_v >= 0.2, dx {} -> {}", runs[k].dx, runs[k + 1].dx),
+        std::log(lc / lf) / std::log(runs[k].dx / runs[k + 1].dx), ">=", 1.0, ""));
     conv += fmt::format("; T_v >= 0.2: e2 {:.3e} -> {:.3e}", lc, lf);
   }
   rep.notes.push_back("convergence: " + conv);
   for (const auto& r : runs) {
     rep.notes.push_back(fmt::format(
-        "dx = {}: e_inf/p0 at T_v = 0.05/0.1/0.2/0.5/1 = {:.4f} / {:.4f} / {:.4f} / {:.4f} / {:.4f}; max|U_h - U| = {:.4f}; "
+        "dx = {}: e_inf/p0 at T_v = 0.05/0.1/0.2/0.5/1 = {:.4f} / {:.4f} / {:.4f} / {:.4f} / {:.4f}; max|U_h - U| = "
+        "{:.4f}; "
         "S(40 s) = {:.4e} m (exact {:.4e}); PCG (Jacobi) iterations mean {:.1f}, max {}, max relative residual "
         "{:.2e}; pressure step {:.0f} % of the loop time ({:.1f} s)",
         r.dx, r.einf[0], r.einf[1], r.einf[2], r.einf[3], r.einf[4], r.u_err, r.s_final, ref.settlement(kEnd),

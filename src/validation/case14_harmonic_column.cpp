@@ -67,7 +67,8 @@ HarmonicRun run_harmonic(const std::string& case_file, double period, double dx)
   const auto nn = static_cast<std::size_t>(nodes.size());
   std::vector<std::size_t> order(nn);
   for (std::size_t i = 0; i < nn; ++i) order[i] = i;
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return nodes.position[a][0] > nodes.position[b][0]; });
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return nodes.position[a][0] > nodes.position[b][0]; });
   HarmonicRun out;
   out.period = period;
   out.dx = dx;
@@ -137,8 +138,9 @@ CaseReport validate_case14(const Options& opt, const std::string& dir) {
   CaseReport rep;
   rep.id = "14";
   rep.title = "Harmonic loading of a saturated soil column (V3)";
-  rep.reference = "exact steady-state u-p_w solution of docs/cases.md Case 14 (4x4 complex system, "
-                  "src/validation/analytic_saturated.hpp); envelope max|p_w| over the last 2 periods";
+  rep.reference =
+      "exact steady-state u-p_w solution of docs/cases.md Case 14 (4x4 complex system, "
+      "src/validation/analytic_saturated.hpp); envelope max|p_w| over the last 2 periods";
   const std::string case_file = (fs::path(opt.cases_dir) / "14_harmonic_loading_column.toml").string();
   const std::vector<double> periods = {0.5, 2.0, 10.0};
   std::vector<double> spacings = {0.1};
@@ -151,11 +153,14 @@ CaseReport validate_case14(const Options& opt, const std::string& dir) {
     }
     const double tol = T < 1.0 ? 0.08 : 0.05;
     for (const auto& r : runs) {
-      rep.metrics.push_back(metric(fmt::format("T = {} s, dx = {}: envelope e_inf / q0", T, r.dx), r.einf, "<=", tol, ""));
-      rep.metrics.push_back(metric(fmt::format("T = {} s, dx = {}: surface displacement amplitude, relative error", T, r.dx),
-                                   std::abs(r.u_amp - r.u_ref) / r.u_ref, "<=", 0.05, ""));
+      rep.metrics.push_back(
+          metric(fmt::format("T = {} s, dx = {}: envelope e_inf / q0", T, r.dx), r.einf, "<=", tol, ""));
+      rep.metrics.push_back(
+          metric(fmt::format("T = {} s, dx = {}: surface displacement amplitude, relative error", T, r.dx),
+                 std::abs(r.u_amp - r.u_ref) / r.u_ref, "<=", 0.05, ""));
       rep.notes.push_back(fmt::format(
-          "T = {} s, dx = {}: e_inf = {:.4f} q0, |p_w| at the base {:.4f} q0 (exact {:.4f}), surface amplitude {:.4e} m "
+          "T = {} s, dx = {}: e_inf = {:.4f} q0, |p_w| at the base {:.4f} q0 (exact {:.4f}), surface amplitude {:.4e} "
+          "m "
           "(exact {:.4e}); PCG iterations mean {:.1f}, max {}; pressure step {:.0f} % of the loop time ({:.1f} s)",
           T, r.dx, r.einf, r.envelope.back(), r.reference.back(), r.u_amp, r.u_ref, r.iterations_mean, r.iterations_max,
           100.0 * r.pressure_share, r.seconds));
@@ -171,12 +176,14 @@ CaseReport validate_case14(const Options& opt, const std::string& dir) {
     write_run(dir, r);
     rep.metrics.push_back(metric("T = 0.1 s (optional), dx = 0.1: relative error of the peak envelope (exact 4.203 q0)",
                                  std::abs(r.peak - 4.203) / 4.203, "<=", 0.15, ""));
-    rep.notes.push_back(fmt::format("T = 0.1 s: peak envelope {:.3f} q0 (exact 4.203), e_inf = {:.3f} q0", r.peak, r.einf));
+    rep.notes.push_back(
+        fmt::format("T = 0.1 s: peak envelope {:.3f} q0 (exact 4.203), e_inf = {:.3f} q0", r.peak, r.einf));
   }
-  rep.notes.push_back(fmt::format("each run lasts max(10 T, 5 tau_1) = max(10 T, {:.1f} s), tau_1 = 4 L^2/(pi^2 c_v) the "
-                                  "first consolidation mode: the mean pore pressure a sine load leaves at start-up "
-                                  "decays with it",
-                                  run_length(0.0)));
+  rep.notes.push_back(
+      fmt::format("each run lasts max(10 T, 5 tau_1) = max(10 T, {:.1f} s), tau_1 = 4 L^2/(pi^2 c_v) the "
+                  "first consolidation mode: the mean pore pressure a sine load leaves at start-up "
+                  "decays with it",
+                  run_length(0.0)));
   if (!opt.full) rep.notes.push_back("quick mode: dx = 0.1 m only; --full adds dx = 0.05 m (convergence)");
   std::string note;
   if (opt.plots && run_plot_script("plot_case14.py", dir, note)) {

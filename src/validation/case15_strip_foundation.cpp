@@ -70,13 +70,13 @@ double checkerboard(const Simulation<2>& s, double dx) {
 
 }  // namespace
 
-
 CaseReport validate_case15(const Options& opt, const std::string& dir) {
   CaseReport rep;
   rep.id = "15";
   rep.title = "Strip foundation on saturated soil (V3, 2D)";
-  rep.reference = "docs/cases.md Case 15: plane-strain FE undrained table (time average 0.5-1.5 s of the k = 1e-5 m/s "
-                  "run) and drained end-state settlements";
+  rep.reference =
+      "docs/cases.md Case 15: plane-strain FE undrained table (time average 0.5-1.5 s of the k = 1e-5 m/s "
+      "run) and drained end-state settlements";
   const std::string case_file = (fs::path(opt.cases_dir) / "15_strip_foundation_saturated.toml").string();
   // Quick: 0.25 m, a lattice with a node on the footing edge (x = 3 m), which then takes half
   // the pressure (docs/case-format.md). At 0.5 m the undrained p_w at (0, 1 m) and the centre
@@ -86,7 +86,8 @@ CaseReport validate_case15(const Options& opt, const std::string& dir) {
   // ---- undrained check
   {
     const CaseDocument doc = load_case_document(
-        case_file, {fmt::format("geometry.spacing={}", dx), "fluid.conductivity=1e-5", "time.end=1.5", "output.times=[]"});
+        case_file,
+        {fmt::format("geometry.spacing={}", dx), "fluid.conductivity=1e-5", "time.end=1.5", "output.times=[]"});
     CaseSetup<2> setup = read_case<2>(doc);
     Simulation<2> solver(setup);
     const auto& nodes = solver.nodes();
@@ -104,7 +105,8 @@ CaseReport validate_case15(const Options& opt, const std::string& dir) {
       solver.step();
       if (solver.step_count() % 10 == 0) {
         hist << fmt::format("{:.5g},{:.6e}", solver.time(), -solver.node_displacement()(centre, 1));
-        for (std::size_t k = 0; k < kPoints.size(); ++k) hist << fmt::format(",{:.6g}", solver.node_pore_pressure()[idx[k]] / kSigma0);
+        for (std::size_t k = 0; k < kPoints.size(); ++k)
+          hist << fmt::format(",{:.6g}", solver.node_pore_pressure()[idx[k]] / kSigma0);
         hist << "\n";
       }
       if (solver.time() >= 0.5) {
@@ -117,16 +119,19 @@ CaseReport validate_case15(const Options& opt, const std::string& dir) {
       const double v = sum[k] / static_cast<double>(count) / kSigma0;
       const auto& p = kPoints[k];
       if (p.tol > 0.0) {
-        rep.metrics.push_back(metric(fmt::format("undrained, dx = {}: p_w/sigma0 at {} relative error (FE {})", dx, p.name, p.ref),
-                                     std::abs(v - p.ref) / p.ref, "<=", p.tol, ""));
+        rep.metrics.push_back(
+            metric(fmt::format("undrained, dx = {}: p_w/sigma0 at {} relative error (FE {})", dx, p.name, p.ref),
+                   std::abs(v - p.ref) / p.ref, "<=", p.tol, ""));
       }
-      rep.notes.push_back(fmt::format("undrained, dx = {}: mean p_w/sigma0 over 0.5-1.5 s at {} = {:.4f} (FE {})", dx, p.name, v, p.ref));
+      rep.notes.push_back(fmt::format("undrained, dx = {}: mean p_w/sigma0 over 0.5-1.5 s at {} = {:.4f} (FE {})", dx,
+                                      p.name, v, p.ref));
     }
     const double s = settle / static_cast<double>(count);
     rep.metrics.push_back(metric(fmt::format("undrained, dx = {}: centre settlement relative error (FE 4.56e-4 m)", dx),
                                  std::abs(s - kUndrainedSettlement) / kUndrainedSettlement, "<=", 0.10, ""));
-    rep.metrics.push_back(metric(fmt::format("undrained, dx = {}: checkerboard max|p_I - mean of 4 neighbours| / sigma0 at 1.5 s", dx),
-                                 checkerboard(solver, dx), "<=", 0.01, ""));
+    rep.metrics.push_back(
+        metric(fmt::format("undrained, dx = {}: checkerboard max|p_I - mean of 4 neighbours| / sigma0 at 1.5 s", dx),
+               checkerboard(solver, dx), "<=", 0.01, ""));
   }
 
   // ---- drained end state (k = 1e-3 m/s, 130 s)
@@ -151,7 +156,8 @@ CaseReport validate_case15(const Options& opt, const std::string& dir) {
       const double sc = -solver.node_displacement()(centre, 1);
       double pmax = 0.0;
       for (double p : solver.node_pore_pressure()) pmax = std::max(pmax, std::abs(p));
-      hist << fmt::format("{:.5g},{:.6e},{:.6e},{:.6g}\n", solver.time(), sc, -solver.node_displacement()(edge, 1), pmax / kSigma0);
+      hist << fmt::format("{:.5g},{:.6e},{:.6e},{:.6g}\n", solver.time(), sc, -solver.node_displacement()(edge, 1),
+                          pmax / kSigma0);
       if (solver.time() > 2.0) drop = std::max(drop, last - sc);  // consolidation settlement must not decrease
       const auto w = static_cast<std::size_t>(std::min(130.0, std::floor(solver.time())));
       window_sum[w] += sc;
@@ -161,17 +167,20 @@ CaseReport validate_case15(const Options& opt, const std::string& dir) {
         vib_hi = std::max(vib_hi, sc);
       }
       last = sc;
-      if (std::abs(solver.time() - 15.0) < 0.5 * static_cast<double>(every) * solver.dt()) checker = checkerboard(solver, dx);
+      if (std::abs(solver.time() - 15.0) < 0.5 * static_cast<double>(every) * solver.dt())
+        checker = checkerboard(solver, dx);
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     double pmax = 0.0;
     for (double p : solver.node_pore_pressure()) pmax = std::max(pmax, std::abs(p));
     const double sc = -solver.node_displacement()(centre, 1), se = -solver.node_displacement()(edge, 1);
-    rep.metrics.push_back(metric(fmt::format("drained, dx = {}: final centre settlement relative error (1.091e-3 m)", dx),
-                                 std::abs(sc - kCentreDrained) / kCentreDrained, "<=", 0.05, ""));
+    rep.metrics.push_back(
+        metric(fmt::format("drained, dx = {}: final centre settlement relative error (1.091e-3 m)", dx),
+               std::abs(sc - kCentreDrained) / kCentreDrained, "<=", 0.05, ""));
     rep.metrics.push_back(metric(fmt::format("drained, dx = {}: final edge settlement relative error (6.96e-4 m)", dx),
                                  std::abs(se - kEdgeDrained) / kEdgeDrained, "<=", 0.05, ""));
-    rep.metrics.push_back(metric(fmt::format("drained, dx = {}: max |p_w| / sigma0 at 130 s", dx), pmax / kSigma0, "<=", 0.01, ""));
+    rep.metrics.push_back(
+        metric(fmt::format("drained, dx = {}: max |p_w| / sigma0 at 130 s", dx), pmax / kSigma0, "<=", 0.01, ""));
     double window_drop = 0.0, previous = -1.0;
     for (std::size_t w = 2; w < 130; ++w) {
       if (window_count[w] == 0.0) continue;
@@ -179,8 +188,9 @@ CaseReport validate_case15(const Options& opt, const std::string& dir) {
       if (previous >= 0.0) window_drop = std::max(window_drop, previous - mean);
       previous = mean;
     }
-    Metric monotonic = metric(fmt::format("drained, dx = {}: largest decrease of the centre settlement after 2 s / S_final", dx),
-                              drop / sc, "<=", 0.0, "");
+    Metric monotonic =
+        metric(fmt::format("drained, dx = {}: largest decrease of the centre settlement after 2 s / S_final", dx),
+               drop / sc, "<=", 0.0, "");
     if (!monotonic.pass() && window_drop <= 0.02 * sc) {
       monotonic.known_deviation = fmt::format(
           "the raw settlement carries the column's undrained vibration that the 0.1 s load ramp excites (half "
@@ -194,14 +204,16 @@ CaseReport validate_case15(const Options& opt, const std::string& dir) {
                                              "settlement after 2 s / S_final",
                                              dx),
                                  window_drop / sc, "", 0.0, ""));
-    rep.metrics.push_back(metric(fmt::format("drained, dx = {}: checkerboard max|p_I - mean of 4 neighbours| / sigma0 at 15 s", dx),
-                                 checker, "<=", 0.01, ""));
+    rep.metrics.push_back(
+        metric(fmt::format("drained, dx = {}: checkerboard max|p_I - mean of 4 neighbours| / sigma0 at 15 s", dx),
+               checker, "<=", 0.01, ""));
     const PressureSolveStats* ps = &pressure_stage(solver, "case 15").stats();
     if (ps == nullptr) throw SolverError("case 15 is not a V3 case");
-    rep.notes.push_back(fmt::format("drained, dx = {}: centre {:.4e} m, edge {:.4e} m at 130 s; {} nodes, PCG (Jacobi) "
-                                    "iterations mean {:.1f}, max {}, pressure step {:.0f} % of {:.0f} s",
-                                    dx, sc, se, nodes.size(), ps->mean_iterations(), ps->max_iterations,
-                                    100.0 * pressure_stage(solver, "case 15").seconds() / seconds, seconds));
+    rep.notes.push_back(
+        fmt::format("drained, dx = {}: centre {:.4e} m, edge {:.4e} m at 130 s; {} nodes, PCG (Jacobi) "
+                    "iterations mean {:.1f}, max {}, pressure step {:.0f} % of {:.0f} s",
+                    dx, sc, se, nodes.size(), ps->mean_iterations(), ps->max_iterations,
+                    100.0 * pressure_stage(solver, "case 15").seconds() / seconds, seconds));
   }
   if (!opt.full) rep.notes.push_back("quick mode: dx = 0.25 m; --full runs dx = 0.2 m (docs/cases.md)");
   return rep;

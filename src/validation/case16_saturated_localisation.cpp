@@ -75,17 +75,17 @@ struct Snapshot {
 struct SatRun {
   double dx = 0.0, k = 0.0;
   std::vector<double> strain, q, p, dpw, eps_mean, eps_cov;  // histories (volume averages; CoV of eps_vp_eq)
-  double elastic_q_err = 0.0, elastic_pw_err = 0.0;  // max relative error, 0.3-0.9 eps_a,y
+  double elastic_q_err = 0.0, elastic_pw_err = 0.0;          // max relative error, 0.3-0.9 eps_a,y
   int elastic_samples = 0;
-  double q_half = NAN, pw_half = NAN;                // at eps_a = 0.5 eps_a,y
+  double q_half = NAN, pw_half = NAN;                           // at eps_a = 0.5 eps_a,y
   double fy_q = NAN, fy_p = NAN, fy_pw = NAN, fy_strain = NAN;  // first yield
   double q_end = 0.0, p_end = 0.0, pw_end = 0.0, strain_end = 0.0;
   double q_peak = 0.0, strain_peak = 0.0, cov_at_peak = NAN;
-  double cov_eps = NAN, cov_eps_interior = NAN;      // at the end, all nodes / 0.1 m off the platens
+  double cov_eps = NAN, cov_eps_interior = NAN;                  // at the end, all nodes / 0.1 m off the platens
   double checker = 0.0, checker_rms = 0.0, checker_scale = 0.0;  // largest over the snapshots, Pa
   std::vector<Snapshot> snaps;
   BandFit band;
-  double pw_band = NAN, pw_around = NAN;             // mean p_w in the band / in the zone around it
+  double pw_band = NAN, pw_around = NAN;  // mean p_w in the band / in the zone around it
   int around_count = 0;
   // The same with the imperfection's nodes (the seed material) left out of both: the shear band
   // proper, its arms, against their surroundings.
@@ -288,8 +288,9 @@ void write_run(const std::string& dir, const SatRun& r) {
     const Snapshot& s = r.snaps[n];
     const bool last = n + 1 == r.snaps.size();
     for (std::size_t i = 0; i < s.x.size(); ++i) {
-      f << fmt::format("{:.6g},{:.6g},{:.6g},{:.8g},{:.8g},{:.8g},{:.8g},{:.8g},{}\n", s.strain, s.x[i], s.y[i], s.eps[i],
-                       s.pw[i], s.q[i], s.vx[i], s.vy[i], last && !r.band.in_band.empty() ? int(r.band.in_band[i]) : 0);
+      f << fmt::format("{:.6g},{:.6g},{:.6g},{:.8g},{:.8g},{:.8g},{:.8g},{:.8g},{}\n", s.strain, s.x[i], s.y[i],
+                       s.eps[i], s.pw[i], s.q[i], s.vx[i], s.vy[i],
+                       last && !r.band.in_band.empty() ? int(r.band.in_band[i]) : 0);
     }
   }
 }
@@ -300,9 +301,10 @@ CaseReport validate_case16(const Options& opt, const std::string& dir) {
   CaseReport rep;
   rep.id = "16";
   rep.title = "Saturated Cam-Clay plane-strain compression, strain localisation (V3)";
-  rep.reference = "closed forms of docs/cases.md Case 16 (constant M, constant E and nu): undrained elastic stage "
-                  "dp_w = B(1+nu_u)s/3 and q = s sqrt(1-nu_u+nu_u^2), first yield q_y = 159.1 kPa, undrained "
-                  "critical state p'_f = 183.0 kPa, q_f = 219.6 kPa; band-angle bounds 43-68 deg";
+  rep.reference =
+      "closed forms of docs/cases.md Case 16 (constant M, constant E and nu): undrained elastic stage "
+      "dp_w = B(1+nu_u)s/3 and q = s sqrt(1-nu_u+nu_u^2), first yield q_y = 159.1 kPa, undrained "
+      "critical state p'_f = 183.0 kPa, q_f = 219.6 kPa; band-angle bounds 43-68 deg";
   const std::string case_file = (fs::path(opt.cases_dir) / "16_saturated_cam_clay_localisation_2d.toml").string();
   const Undrained u;
   const double s_y = u.yield_s();
@@ -336,22 +338,26 @@ CaseReport validate_case16(const Options& opt, const std::string& dir) {
 
   for (const SatRun* r : {&und, &loc}) {
     const std::string tag = fmt::format("k = {:g} m/s: ", r->k);
-    rep.metrics.push_back(metric(tag + "elastic stage, max |q / closed form - 1| over 0.3-0.9 eps_a,y", r->elastic_q_err,
-                                 "<=", 0.03, ""));
+    rep.metrics.push_back(metric(tag + "elastic stage, max |q / closed form - 1| over 0.3-0.9 eps_a,y",
+                                 r->elastic_q_err, "<=", 0.03, ""));
     rep.metrics.push_back(metric(tag + "elastic stage, max |mean dp_w / closed form - 1| over 0.3-0.9 eps_a,y",
                                  r->elastic_pw_err, "<=", 0.03, ""));
     const double dq = r->fy_q / q_y - 1.0;
-    rep.metrics.push_back(metric(tag + fmt::format("first yield (mean eps_vp_eq = {:g}): q / q_y - 1 (upper +4 %)", kYieldEps),
-                                 dq, "<=", 0.04, ""));
+    rep.metrics.push_back(
+        metric(tag + fmt::format("first yield (mean eps_vp_eq = {:g}): q / q_y - 1 (upper +4 %)", kYieldEps), dq,
+               "<=", 0.04, ""));
     rep.metrics.push_back(metric(tag + "first yield: q / q_y - 1 (lower +0 %)", dq, ">=", 0.0, ""));
     rep.metrics.push_back(metric(tag + "checkerboard: max alternating p_w component / max |p_w| (snapshots 3, 5, 8 %)",
                                  r->checker_scale > 0.0 ? r->checker / r->checker_scale : NAN, "<=", 0.01, ""));
     rep.notes.push_back(fmt::format(
         "k = {:g} m/s, dx = {} m: at eps_a = 0.5 eps_a,y q = {:.2f} kPa (closed form {:.2f}), mean dp_w = {:.2f} kPa "
-        "({:.2f}); first yield at eps_a = {:.3f} % (closed form {:.3f} %), q = {:.1f} kPa, p' = {:.1f} kPa, dp_w = {:.1f} "
-        "kPa (closed form {:.1f}); at {:.1f} %: q = {:.1f} kPa, p' = {:.1f} kPa, mean p_w = {:.1f} kPa; peak q {:.1f} kPa "
+        "({:.2f}); first yield at eps_a = {:.3f} % (closed form {:.3f} %), q = {:.1f} kPa, p' = {:.1f} kPa, dp_w = "
+        "{:.1f} "
+        "kPa (closed form {:.1f}); at {:.1f} %: q = {:.1f} kPa, p' = {:.1f} kPa, mean p_w = {:.1f} kPa; peak q {:.1f} "
+        "kPa "
         "at {:.2f} %; CoV of eps_vp_eq {:.3f} (all nodes), {:.3f} (0.1 m off the platens); p_w checkerboard max {:.3g} "
-        "kPa, rms {:.3g} kPa, max |p_w| {:.1f} kPa; {} steps, RK4 sub-steps max {}, PCG (Jacobi) iterations mean {:.1f}, "
+        "kPa, rms {:.3g} kPa, max |p_w| {:.1f} kPa; {} steps, RK4 sub-steps max {}, PCG (Jacobi) iterations mean "
+        "{:.1f}, "
         "max {}, max residual {:.1e}; pressure step {:.0f} % of {:.0f} s",
         r->k, r->dx, r->q_half / 1e3, u.q(u.s_of_strain(0.5 * eps_y)) / 1e3, r->pw_half / 1e3,
         u.dpw(u.s_of_strain(0.5 * eps_y)) / 1e3, 100 * r->fy_strain, 100 * eps_y, r->fy_q / 1e3, r->fy_p / 1e3,
@@ -362,15 +368,15 @@ CaseReport validate_case16(const Options& opt, const std::string& dir) {
   }
   // ---- k = 1e-9: homogeneous undrained response to the critical state, no band
   const std::string te = fmt::format("at {:.0f} %", 100 * und.strain_end);
-  rep.metrics.push_back(metric("k = 1e-9 m/s: |p' " + te + " / p'_f - 1| (p'_f = 183.0 kPa)", std::abs(und.p_end / p_f - 1.0),
-                               "<=", 0.05, ""));
-  rep.metrics.push_back(metric("k = 1e-9 m/s: |q " + te + " / q_f - 1| (q_f = 219.6 kPa)", std::abs(und.q_end / q_f - 1.0),
-                               "<=", 0.05, ""));
+  rep.metrics.push_back(metric("k = 1e-9 m/s: |p' " + te + " / p'_f - 1| (p'_f = 183.0 kPa)",
+                               std::abs(und.p_end / p_f - 1.0), "<=", 0.05, ""));
+  rep.metrics.push_back(metric("k = 1e-9 m/s: |q " + te + " / q_f - 1| (q_f = 219.6 kPa)",
+                               std::abs(und.q_end / q_f - 1.0), "<=", 0.05, ""));
   rep.metrics.push_back(metric("k = 1e-9 m/s: p' " + te, und.p_end / 1e3, "", 0, "kPa"));
   rep.metrics.push_back(metric("k = 1e-9 m/s: q " + te, und.q_end / 1e3, "", 0, "kPa"));
   {
-    Metric m = metric("k = 1e-9 m/s: coefficient of variation of eps_vp_eq " + te + " (all nodes)", und.cov_eps, "<=",
-                      0.20, "");
+    Metric m = metric("k = 1e-9 m/s: coefficient of variation of eps_vp_eq " + te + " (all nodes)", und.cov_eps,
+                      "<=", 0.20, "");
     if (!m.pass()) {
       m.known_deviation =
           "the 'undrained' sample forms a conjugate pair of bands from the imperfection. The law has no undrained "
@@ -383,16 +389,19 @@ CaseReport validate_case16(const Options& opt, const std::string& dir) {
   }
   rep.metrics.push_back(metric("k = 1e-9 m/s: coefficient of variation of eps_vp_eq, 0.1 m off the platens",
                                und.cov_eps_interior, "", 0, ""));
-  rep.metrics.push_back(metric(fmt::format("k = 1e-9 m/s: coefficient of variation of eps_vp_eq at the peak of q ({:.2f} %)",
-                                           100 * und.strain_peak),
-                               und.cov_at_peak, "", 0, ""));
+  rep.metrics.push_back(
+      metric(fmt::format("k = 1e-9 m/s: coefficient of variation of eps_vp_eq at the peak of q ({:.2f} %)",
+                         100 * und.strain_peak),
+             und.cov_at_peak, "", 0, ""));
   // ---- k = 1e-6: a band, with lower p_w inside
   for (const bool lower : {true, false}) {
-    Metric m = metric("k = 1e-6 m/s: band angle to the horizontal " + te + (lower ? " (lower bound)" : " (upper bound)"),
-                      loc.band.angle, lower ? ">=" : "<=", lower ? 43.0 : 68.0, "deg");
+    Metric m =
+        metric("k = 1e-6 m/s: band angle to the horizontal " + te + (lower ? " (lower bound)" : " (upper bound)"),
+               loc.band.angle, lower ? ">=" : "<=", lower ? 43.0 : 68.0, "deg");
     if (!m.pass() && loc.band.particles < 30) {
       m.known_deviation = fmt::format(
-          "the cloud above 50 % of the maximum eps_vp_eq is {} particles, the imperfection zone itself (as in the quick "
+          "the cloud above 50 % of the maximum eps_vp_eq is {} particles, the imperfection zone itself (as in the "
+          "quick "
           "run of case 3): at this resolution the bands (a conjugate pair from the imperfection, see the maps) carry "
           "less than half the imperfection's strain, so docs/cases.md §1.3's threshold does not see them",
           loc.band.particles);
@@ -403,8 +412,8 @@ CaseReport validate_case16(const Options& opt, const std::string& dir) {
   rep.metrics.push_back(metric("k = 1e-6 m/s: band lower arm angle", loc.band.lower, "", 0, "deg"));
   rep.metrics.push_back(metric("k = 1e-6 m/s: whole-cloud principal axis angle", loc.band.whole, "", 0, "deg"));
   rep.metrics.push_back(metric("k = 1e-6 m/s: particles in the band (eps >= 50 % max)", loc.band.particles, "", 0, ""));
-  rep.metrics.push_back(metric("k = 1e-6 m/s: coefficient of variation of eps_vp_eq " + te + " (all nodes)", loc.cov_eps, "",
-                               0, ""));
+  rep.metrics.push_back(
+      metric("k = 1e-6 m/s: coefficient of variation of eps_vp_eq " + te + " (all nodes)", loc.cov_eps, "", 0, ""));
   {
     Metric m = metric("k = 1e-6 m/s: mean p_w in the band - mean p_w within 0.2 m around it (must be < 0)",
                       (loc.pw_band - loc.pw_around) / 1e3, "<=", 0.0, "kPa");
@@ -419,27 +428,31 @@ CaseReport validate_case16(const Options& opt, const std::string& dir) {
     }
     rep.metrics.push_back(m);
   }
-  rep.metrics.push_back(metric("k = 1e-6 m/s: mean p_w in the band's arms - within 0.2 m around them (imperfection left out)",
-                               (loc.pw_arms - loc.pw_arms_around) / 1e3, "", 0, "kPa"));
+  rep.metrics.push_back(
+      metric("k = 1e-6 m/s: mean p_w in the band's arms - within 0.2 m around them (imperfection left out)",
+             (loc.pw_arms - loc.pw_arms_around) / 1e3, "", 0, "kPa"));
   rep.notes.push_back(fmt::format(
       "k = 1e-6 m/s band {}: {} particles, angle {:.1f} deg (arms {:.1f} / {:.1f}, whole cloud {:.1f}), axis {:.3f} m "
       "from the imperfection centre; mean p_w {:.2f} kPa in the band, {:.2f} kPa in the {} nodes around it",
-      loc.band.pair ? "(conjugate pair, angle = mean of the arms)" : "(single band, angle = principal axis of the cloud)",
+      loc.band.pair ? "(conjugate pair, angle = mean of the arms)"
+                    : "(single band, angle = principal axis of the cloud)",
       loc.band.particles, loc.band.angle, loc.band.upper, loc.band.lower, loc.band.whole, loc.band.offset,
       loc.pw_band / 1e3, loc.pw_around / 1e3, loc.around_count));
   if (loc.band.particles < 30) {
-    rep.notes.push_back(fmt::format("k = 1e-6 m/s: the cloud above 50 % of the maximum eps_vp_eq has only {} particles: it "
-                                    "is the imperfection zone, not a developed band, so the band angle and the p_w "
-                                    "comparison refer to that zone; read the maps",
-                                    loc.band.particles));
+    rep.notes.push_back(
+        fmt::format("k = 1e-6 m/s: the cloud above 50 % of the maximum eps_vp_eq has only {} particles: it "
+                    "is the imperfection zone, not a developed band, so the band angle and the p_w "
+                    "comparison refer to that zone; read the maps",
+                    loc.band.particles));
   }
   rep.notes.push_back(fmt::format(
       "k = 1e-9 m/s band fit for comparison: {} particles, angle {:.1f} deg; mean p_w in that cloud {:.2f} kPa, around "
       "it {:.2f} kPa",
       und.band.particles, und.band.angle, und.pw_band / 1e3, und.pw_around / 1e3));
-  rep.notes.push_back("checkerboard measure: the fourth difference |f_(i-2) - 4 f_(i-1) + 6 f_i - 4 f_(i+1) + f_(i+2)|/16 "
-                      "along x and y (exact amplitude of a node-to-node alternation, zero for any cubic field), largest "
-                      "over the nodes whose stencils fit in the sample, divided by max |p_w|");
+  rep.notes.push_back(
+      "checkerboard measure: the fourth difference |f_(i-2) - 4 f_(i-1) + 6 f_i - 4 f_(i+1) + f_(i+2)|/16 "
+      "along x and y (exact amplitude of a node-to-node alternation, zero for any cubic field), largest "
+      "over the nodes whose stencils fit in the sample, divided by max |p_w|");
   if (!opt.full) rep.notes.push_back("quick mode: dx = 0.04 m; --full runs docs/cases.md's 0.02 m");
   std::string note;
   if (opt.plots && run_plot_script("plot_case16.py", dir, note)) {

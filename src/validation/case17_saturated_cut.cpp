@@ -47,9 +47,9 @@ PwState capture(const Simulation<2>& solver) {
 struct SatCut {
   double n_stab = 0.0, k = 0.0;
   CutRun run;
-  PwState ramp, hold;  // at the end of the ramp (3 s) and after 3 s of hold (6 s)
-  double uc6 = NAN;    // crest displacement at t = 6 s
-  double pw_lower = NAN, p_lower = NAN;  // end of ramp: means over the lower half away from the drained faces
+  PwState ramp, hold;                              // at the end of the ramp (3 s) and after 3 s of hold (6 s)
+  double uc6 = NAN;                                // crest displacement at t = 6 s
+  double pw_lower = NAN, p_lower = NAN;            // end of ramp: means over the lower half away from the drained faces
   double pw_lower_hold = NAN, p_lower_hold = NAN;  // the same at 6 s
   double checker = 0.0, checker_rms = 0.0, checker_scale = 0.0;
   double checker_time = NAN;
@@ -133,9 +133,10 @@ CaseReport validate_case17(const Options& opt, const std::string& dir) {
   CaseReport rep;
   rep.id = "17";
   rep.title = "Saturated vertical cut (V3)";
-  rep.reference = "docs/cases.md Case 17: limit analysis of a vertical cut in a Tresca material with gamma_sat, N_c = "
-                  "gamma_sat H/c ~ 3.78 (bracket 2.83-4.00), independent of k; circular mechanism emerging 0.91H behind "
-                  "the crest; undrained ramp: p_w = mean total stress";
+  rep.reference =
+      "docs/cases.md Case 17: limit analysis of a vertical cut in a Tresca material with gamma_sat, N_c = "
+      "gamma_sat H/c ~ 3.78 (bracket 2.83-4.00), independent of k; circular mechanism emerging 0.91H behind "
+      "the crest; undrained ramp: p_w = mean total stress";
   const std::string file = (fs::path(opt.cases_dir) / "17_saturated_vertical_cut_2d.toml").string();
   const double dx = opt.full ? 0.25 : 0.5;
   std::vector<SatCut> runs;
@@ -158,9 +159,10 @@ CaseReport validate_case17(const Options& opt, const std::string& dir) {
     const double a = runs[0].uc6, b = runs[1].uc6;
     rep.metrics.push_back(metric(tag + "N = 3.4: |u_c(6 s, k = 1e-5) - u_c(6 s, k = 1e-7)| / their mean",
                                  std::abs(a - b) / (0.5 * (std::abs(a) + std::abs(b))), "<=", 0.20, ""));
-    rep.notes.push_back(fmt::format("N = 3.4: u_c(6 s) = {:.4e} m (k = 1e-5 m/s), {:.4e} m (k = 1e-7 m/s); N = 4.2: "
-                                    "{:.4e} m, {:.4e} m",
-                                    a, b, runs[2].uc6, runs[3].uc6));
+    rep.notes.push_back(
+        fmt::format("N = 3.4: u_c(6 s) = {:.4e} m (k = 1e-5 m/s), {:.4e} m (k = 1e-7 m/s); N = 4.2: "
+                    "{:.4e} m, {:.4e} m",
+                    a, b, runs[2].uc6, runs[3].uc6));
   }
   // Mechanism of the collapse runs.
   std::string emergence_csv = "label,emergence,toe_distance\n";
@@ -170,9 +172,10 @@ CaseReport validate_case17(const Options& opt, const std::string& dir) {
     const double emerge = emergence_behind_crest(r.run.final_state, dx, kW, kH);
     const double toe = band_distance_to(r.run.final_state, kW, 0.0, 0.0);
     rep.metrics.push_back(metric(rt + "emergence on the top behind the crest, >= 0.7 H", emerge, ">=", 0.7 * kH, "m"));
-    rep.metrics.push_back(metric(rt + "emergence on the top behind the crest, <= 1.15 H", emerge, "<=", 1.15 * kH, "m"));
-    rep.metrics.push_back(metric(rt + "distance of the failure surface (eps_vp_eq >= 50 % of max) from the toe", toe, "",
-                                 0, "m"));
+    rep.metrics.push_back(
+        metric(rt + "emergence on the top behind the crest, <= 1.15 H", emerge, "<=", 1.15 * kH, "m"));
+    rep.metrics.push_back(
+        metric(rt + "distance of the failure surface (eps_vp_eq >= 50 % of max) from the toe", toe, "", 0, "m"));
     emergence_csv += fmt::format("{},{},{}\n", label(r), emerge, toe);
   }
   std::ofstream(fs::path(dir) / "meta.csv") << fmt::format("dx,H,W\n{},{},{}\n", dx, kH, kW);
@@ -187,20 +190,23 @@ CaseReport validate_case17(const Options& opt, const std::string& dir) {
     rep.metrics.push_back(metric(rt + "change of mean p_w over the hold 3 -> 6 s / its value at 3 s (same region; "
                                       "physically ~0: drainage reaches about sqrt(c_v t) < 1 m in 6 s)",
                                  r.pw_lower_hold / r.pw_lower - 1.0, "", 0, ""));
-    rep.notes.push_back(fmt::format("N = {}, k = {:g} m/s: end of ramp (t = {:.3f} s) mean p_w = {:.1f} kPa, mean total "
-                                    "stress {:.1f} kPa over y <= H/2, x <= W - H/2; p_w checkerboard max {:.3g} kPa, rms "
-                                    "{:.3g} kPa (at t = {:.2f} s, max |p_w| {:.1f} kPa)",
-                                    r.n_stab, r.k, r.ramp.time, r.pw_lower / 1e3, r.p_lower / 1e3, r.checker / 1e3,
-                                    r.checker_rms / 1e3, r.checker_time, r.checker_scale / 1e3));
+    rep.notes.push_back(
+        fmt::format("N = {}, k = {:g} m/s: end of ramp (t = {:.3f} s) mean p_w = {:.1f} kPa, mean total "
+                    "stress {:.1f} kPa over y <= H/2, x <= W - H/2; p_w checkerboard max {:.3g} kPa, rms "
+                    "{:.3g} kPa (at t = {:.2f} s, max |p_w| {:.1f} kPa)",
+                    r.n_stab, r.k, r.ramp.time, r.pw_lower / 1e3, r.p_lower / 1e3, r.checker / 1e3, r.checker_rms / 1e3,
+                    r.checker_time, r.checker_scale / 1e3));
   }
-  rep.notes.push_back("checkerboard measure: the fourth difference |f_(i-2) - 4 f_(i-1) + 6 f_i - 4 f_(i+1) + f_(i+2)|/16 "
-                      "along x and y (exact amplitude of a node-to-node alternation, zero for any cubic field) over the "
-                      "non-drained nodes, divided by max |p_w|");
+  rep.notes.push_back(
+      "checkerboard measure: the fourth difference |f_(i-2) - 4 f_(i-1) + 6 f_i - 4 f_(i+1) + f_(i+2)|/16 "
+      "along x and y (exact amplitude of a node-to-node alternation, zero for any cubic field) over the "
+      "non-drained nodes, divided by max |p_w|");
   if (!opt.full) rep.notes.push_back("quick mode: dx = 0.5 m; --full runs docs/cases.md's 0.25 m");
   if (opt.plots) {
     std::string note;
     if (run_plot_script("plot_case17.py", dir, note)) {
-      for (const char* p : {"case17/histories.png", "case17/pw_maps.png", "case17/eps_maps.png"}) rep.plots.push_back(p);
+      for (const char* p : {"case17/histories.png", "case17/pw_maps.png", "case17/eps_maps.png"})
+        rep.plots.push_back(p);
     } else {
       rep.notes.push_back(note);
     }

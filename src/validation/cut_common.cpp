@@ -17,9 +17,12 @@ namespace rktsph::validation {
 
 const char* outcome_name(CutOutcome o) {
   switch (o) {
-    case CutOutcome::stable: return "stable";
-    case CutOutcome::collapse: return "collapse";
-    default: return "undecided";
+    case CutOutcome::stable:
+      return "stable";
+    case CutOutcome::collapse:
+      return "collapse";
+    default:
+      return "undecided";
   }
 }
 
@@ -35,8 +38,8 @@ double sample_at(const std::vector<double>& t, const std::vector<double>& f, dou
 }
 }  // namespace
 
-Classification classify_cut(const std::vector<double>& t, const std::vector<double>& uc,
-                            const std::vector<double>& ke, double H, double window) {
+Classification classify_cut(const std::vector<double>& t, const std::vector<double>& uc, const std::vector<double>& ke,
+                            double H, double window) {
   Classification c;
   if (t.empty()) return c;
   const double t_end = t.back();
@@ -88,8 +91,8 @@ CutSnapshot snapshot(const Simulation<2>& solver, double time) {
   return s;
 }
 
-CutRun run_cut(const std::string& file, const std::vector<std::string>& overrides, double record_dt,
-               double onset_uc, const StepHook& hook) {
+CutRun run_cut(const std::string& file, const std::vector<std::string>& overrides, double record_dt, double onset_uc,
+               const StepHook& hook) {
   static std::map<std::string, CutRun> cache;
   std::string key = file + fmt::format("|{}|{}", record_dt, onset_uc);
   for (const auto& o : overrides) key += "|" + o;
@@ -236,8 +239,8 @@ double bilinear(const CutSnapshot& s, const std::vector<double>& field, double d
   return wsum > 0.0 ? acc / wsum : NAN;
 }
 
-void row_profile(const CutSnapshot& s, const std::vector<double>& field, double y0, double dx,
-                 std::vector<double>& xs, std::vector<double>& fs) {
+void row_profile(const CutSnapshot& s, const std::vector<double>& field, double y0, double dx, std::vector<double>& xs,
+                 std::vector<double>& fs) {
   std::vector<std::pair<double, double>> row;
   for (std::size_t i = 0; i < s.x.size(); ++i) {
     if (std::abs(s.y[i] - y0) < 1e-6 * dx) row.emplace_back(s.x[i], field[i]);
@@ -251,8 +254,7 @@ void row_profile(const CutSnapshot& s, const std::vector<double>& field, double 
   }
 }
 
-double fwhm(const std::vector<double>& x, const std::vector<double>& f, double xlo, double xhi,
-            double& peak_x) {
+double fwhm(const std::vector<double>& x, const std::vector<double>& f, double xlo, double xhi, double& peak_x) {
   std::size_t k = x.size();
   for (std::size_t i = 0; i < x.size(); ++i) {
     if (x[i] < xlo || x[i] > xhi) continue;
@@ -320,14 +322,15 @@ Metric outcome_metric(const std::string& name, const CutRun& r, CutOutcome expec
 }
 
 std::string run_note(const std::string& label, const CutRun& r) {
-  return fmt::format("{}: dx = {} m, {} steps (dt = {:.3g} s), {:.1f} s wall, outcome {}, u_c(end) = {:.4g} m, "
-                     "u_c change over the last second {:.3g} m (stable below {:.3g}), kinetic energy in the last "
-                     "second / peak = {:.3g} (stable below 0.01), damping off at {}{}",
-                     label, r.dx, r.steps, r.dt, r.seconds, outcome_name(r.classification.outcome),
-                     r.classification.uc_end, r.classification.uc_change, 1e-3 * r.height, r.classification.ke_ratio,
-                     std::isfinite(r.damping_off_time) ? fmt::format("t = {:.2f} s", r.damping_off_time)
-                                                      : std::string("damping.until (the kinetic-energy switch did not fire)"),
-                     r.error.empty() ? "" : "; stopped: " + r.error);
+  return fmt::format(
+      "{}: dx = {} m, {} steps (dt = {:.3g} s), {:.1f} s wall, outcome {}, u_c(end) = {:.4g} m, "
+      "u_c change over the last second {:.3g} m (stable below {:.3g}), kinetic energy in the last "
+      "second / peak = {:.3g} (stable below 0.01), damping off at {}{}",
+      label, r.dx, r.steps, r.dt, r.seconds, outcome_name(r.classification.outcome), r.classification.uc_end,
+      r.classification.uc_change, 1e-3 * r.height, r.classification.ke_ratio,
+      std::isfinite(r.damping_off_time) ? fmt::format("t = {:.2f} s", r.damping_off_time)
+                                        : std::string("damping.until (the kinetic-energy switch did not fire)"),
+      r.error.empty() ? "" : "; stopped: " + r.error);
 }
 
 }  // namespace rktsph::validation

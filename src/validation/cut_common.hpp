@@ -30,8 +30,8 @@ struct Classification {
 ///           the last half window exceeds that over the half window before by more than 10 %
 ///           and is larger than 1e-3 H);
 ///  undecided otherwise.
-Classification classify_cut(const std::vector<double>& t, const std::vector<double>& uc,
-                            const std::vector<double>& ke, double H, double window = 1.0);
+Classification classify_cut(const std::vector<double>& t, const std::vector<double>& uc, const std::vector<double>& ke,
+                            double H, double window = 1.0);
 
 /// Nodal fields of a cut at one time (regular lattice, 2D).
 struct CutSnapshot {
@@ -43,18 +43,18 @@ struct CutRun {
   double dx = 0.0, width = 0.0, height = 0.0, dt = 0.0;
   std::vector<double> t, uc, uyc, ke;  // histories: crest u_x, crest u_y, kinetic energy (J/m)
   CutSnapshot final_state;
-  CutSnapshot onset;                   // when u_c first exceeded the onset threshold (if it did)
+  CutSnapshot onset;  // when u_c first exceeded the onset threshold (if it did)
   bool has_onset = false;
   /// When u_c first exceeded the collapse threshold 0.05 H (docs/cases.md §1.3), if it did: fields
   /// of different runs compared at the same crest displacement.
   CutSnapshot at_collapse;
   bool has_collapse_state = false;
-  double damping_off_time = 0.0;       // s, infinity if the kinetic-energy switch never fired
+  double damping_off_time = 0.0;  // s, infinity if the kinetic-energy switch never fired
   double peak_ke = 0.0;
   long steps = 0;
   long max_substeps = 0;
   double seconds = 0.0;
-  std::string error;                   // non-empty if the solver stopped (non-finite state)
+  std::string error;  // non-empty if the solver stopped (non-finite state)
   /// Traction residuals at the end: the stress points' stresses extrapolated linearly
   /// from the two stress-point columns (rows) next to the face x = W (the top y = H), largest
   /// |sigma_xx|, |sigma_xy| on the face (|sigma_yy|, |sigma_xy| on the top), Pa. The nodal
@@ -97,12 +97,11 @@ double bilinear(const CutSnapshot& s, const std::vector<double>& field, double d
 /// Full width at half maximum of a 1-D profile f(x) around its largest value inside
 /// [xlo, xhi] (linear interpolation of the crossings); NaN if it is not bracketed. The peak
 /// position is returned in `peak_x`.
-double fwhm(const std::vector<double>& x, const std::vector<double>& f, double xlo, double xhi,
-            double& peak_x);
+double fwhm(const std::vector<double>& x, const std::vector<double>& f, double xlo, double xhi, double& peak_x);
 
 /// Nodes of the row y = y0 (sorted by x) of field f: x and values.
-void row_profile(const CutSnapshot& s, const std::vector<double>& field, double y0, double dx,
-                 std::vector<double>& xs, std::vector<double>& fs);
+void row_profile(const CutSnapshot& s, const std::vector<double>& field, double y0, double dx, std::vector<double>& xs,
+                 std::vector<double>& fs);
 
 /// Smallest distance from the point (px, py) to a node where eps >= 0.5 max(eps) (the band
 /// cloud of docs/cases.md §1.3), with the maximum taken over nodes with y >= ymin.

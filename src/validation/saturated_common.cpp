@@ -7,9 +7,8 @@
 
 namespace rktsph::validation {
 
-double checkerboard_amplitude(const std::vector<double>& x, const std::vector<double>& y,
-                              const std::vector<double>& f, double dx, double* rms,
-                              const std::vector<bool>* skip) {
+double checkerboard_amplitude(const std::vector<double>& x, const std::vector<double>& y, const std::vector<double>& f,
+                              double dx, double* rms, const std::vector<bool>* skip) {
   std::map<std::pair<long, long>, double> grid;
   for (std::size_t i = 0; i < x.size(); ++i) {
     if (skip != nullptr && (*skip)[i]) continue;

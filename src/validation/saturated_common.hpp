@@ -26,8 +26,7 @@ const PorePressureStage<Dim>& pressure_stage(const Simulation<Dim>& solver, cons
 /// oscillation. Returns max over nodes of max(a_x, a_y); `rms` receives its root mean square.
 /// Nodes with `skip[i]` true (e.g. drained nodes, where p_w is prescribed and a pressure
 /// boundary layer thinner than dx is a step, not an oscillation) are left out of every stencil.
-double checkerboard_amplitude(const std::vector<double>& x, const std::vector<double>& y,
-                              const std::vector<double>& f, double dx, double* rms = nullptr,
-                              const std::vector<bool>* skip = nullptr);
+double checkerboard_amplitude(const std::vector<double>& x, const std::vector<double>& y, const std::vector<double>& f,
+                              double dx, double* rms = nullptr, const std::vector<bool>* skip = nullptr);
 
 }  // namespace rktsph::validation

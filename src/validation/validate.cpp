@@ -31,17 +31,9 @@ bool run_plot_script(const std::string& script, const std::string& data_dir, std
 
 int run_validation(const Options& opt) {
   const std::vector<std::pair<std::string, CaseRunner>> cases = {
-      {"01", validate_case01},
-      {"02", validate_case02},
-      {"03", validate_case03},
-      {"04", validate_case04},
-      {"05", validate_case05},
-      {"06", validate_case06},
-      {"13", validate_case13},
-      {"14", validate_case14},
-      {"15", validate_case15},
-      {"16", validate_case16},
-      {"17", validate_case17},
+      {"01", validate_case01}, {"02", validate_case02}, {"03", validate_case03}, {"04", validate_case04},
+      {"05", validate_case05}, {"06", validate_case06}, {"13", validate_case13}, {"14", validate_case14},
+      {"15", validate_case15}, {"16", validate_case16}, {"17", validate_case17},
   };
   fs::create_directories(opt.out_dir);
   std::vector<CaseReport> reports;
@@ -57,10 +49,11 @@ int run_validation(const Options& opt) {
                              r.passed() ? "PASS" : (r.acceptable() ? "PASS except known deviations" : "FAIL"),
                              r.seconds);
     for (const auto& m : r.metrics) {
-      std::cerr << fmt::format("  [{}] {} = {:.4g}{}{}\n",
-                               m.relation.empty() ? "info" : (m.pass() ? " ok " : (m.known_deviation.empty() ? "FAIL" : "KNOWN")),
-                               m.name, m.value, m.unit.empty() ? "" : " " + m.unit,
-                               m.relation.empty() ? "" : fmt::format(" (tolerance {} {:.4g})", m.relation, m.tolerance));
+      std::cerr << fmt::format(
+          "  [{}] {} = {:.4g}{}{}\n",
+          m.relation.empty() ? "info" : (m.pass() ? " ok " : (m.known_deviation.empty() ? "FAIL" : "KNOWN")), m.name,
+          m.value, m.unit.empty() ? "" : " " + m.unit,
+          m.relation.empty() ? "" : fmt::format(" (tolerance {} {:.4g})", m.relation, m.tolerance));
     }
     reports.push_back(std::move(r));
   }
@@ -84,13 +77,14 @@ int run_validation(const Options& opt) {
     md << fmt::format("\n## Case {} — {}\n\nReference: {}.\n\n", r.id, r.title, r.reference);
     md << "| metric | value | tolerance | status |\n|---|---|---|---|\n";
     for (const auto& m : r.metrics) {
-      md << fmt::format("| {} | {:.4g}{} | {} | {} |\n", m.name, m.value, m.unit.empty() ? "" : " " + m.unit,
-                        m.relation.empty() ? "reported" : fmt::format("{} {:.4g}", m.relation, m.tolerance),
-                        m.relation.empty() ? "—"
-                                           : (m.pass() ? "pass"
-                                                       : (m.known_deviation.empty()
-                                                              ? "**FAIL**"
-                                                              : "**not met** (known: " + m.known_deviation + ")")));
+      md << fmt::format(
+          "| {} | {:.4g}{} | {} | {} |\n", m.name, m.value, m.unit.empty() ? "" : " " + m.unit,
+          m.relation.empty() ? "reported" : fmt::format("{} {:.4g}", m.relation, m.tolerance),
+          m.relation.empty()
+              ? "—"
+              : (m.pass()
+                     ? "pass"
+                     : (m.known_deviation.empty() ? "**FAIL**" : "**not met** (known: " + m.known_deviation + ")")));
     }
     if (!r.notes.empty()) {
       md << "\n";

@@ -25,8 +25,7 @@ struct Metric {
   }
 };
 
-inline Metric metric(std::string name, double value, std::string relation, double tolerance,
-                     std::string unit) {
+inline Metric metric(std::string name, double value, std::string relation, double tolerance, std::string unit) {
   Metric m;
   m.name = std::move(name);
   m.value = value;
@@ -37,7 +36,7 @@ inline Metric metric(std::string name, double value, std::string relation, doubl
 }
 
 struct CaseReport {
-  std::string id;     // "01"
+  std::string id;  // "01"
   std::string title;
   std::string reference;
   std::vector<Metric> metrics;
@@ -61,9 +60,9 @@ struct CaseReport {
 };
 
 struct Options {
-  bool full = false;             // docs/cases.md resolutions (else coarse, CI-sized)
+  bool full = false;  // docs/cases.md resolutions (else coarse, CI-sized)
   std::string out_dir = "validation";
-  std::string cases_dir;         // where cases/thesis lives
+  std::string cases_dir;          // where cases/thesis lives
   std::vector<std::string> only;  // case ids; empty = all
   bool plots = true;
 };

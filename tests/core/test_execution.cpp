@@ -20,8 +20,8 @@ TEST(Execution, SequentialAndThreadsVisitEveryIndexOnce) {
   std::vector<int> seq(static_cast<std::size_t>(n), 0), par(static_cast<std::size_t>(n), 0);
   exec::particle_for(exec::Sequential{}, n, [&](Index i) { seq[static_cast<std::size_t>(i)] += 1; });
   exec::particle_for(exec::Threads{}, n, [&](Index i) { par[static_cast<std::size_t>(i)] += 1; });
-  exec::particle_for(exec::Threads{}, n, [&](Index i) { par[static_cast<std::size_t>(i)] += 1; },
-                     exec::Schedule::dynamic);
+  exec::particle_for(
+      exec::Threads{}, n, [&](Index i) { par[static_cast<std::size_t>(i)] += 1; }, exec::Schedule::dynamic);
   for (Index i = 0; i < n; ++i) {
     EXPECT_EQ(seq[static_cast<std::size_t>(i)], 1);
     EXPECT_EQ(par[static_cast<std::size_t>(i)], 2);

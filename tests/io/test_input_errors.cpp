@@ -65,8 +65,7 @@ struct Outcome {
   std::string file;
 };
 
-Outcome run_case_text(const test::TempDir& dir, const std::string& text,
-                      const std::vector<std::string>& sets = {}) {
+Outcome run_case_text(const test::TempDir& dir, const std::string& text, const std::vector<std::string>& sets = {}) {
   const std::string file = dir.write("bad_case.toml", text);
   std::string cmd = fmt::format("\"{}\" run \"{}\" --out \"{}\" -q", RKTSPH_BINARY, file, dir.file("out"));
   for (const auto& s : sets) cmd += fmt::format(" --set '{}'", s);
@@ -76,8 +75,7 @@ Outcome run_case_text(const test::TempDir& dir, const std::string& text,
 }
 
 // The common contract: status 2 (not a crash), the file and the dotted key named.
-void expect_input_error(const Outcome& o, const std::string& key,
-                        const std::vector<std::string>& also = {}) {
+void expect_input_error(const Outcome& o, const std::string& key, const std::vector<std::string>& also = {}) {
   EXPECT_NE(o.status, 134) << "abort: " << o.err;
   EXPECT_NE(o.status, 139) << "segfault: " << o.err;
   EXPECT_EQ(o.status, 2) << o.err;
@@ -95,8 +93,7 @@ bool names_line(const std::string& err, int line) {
          err.find(fmt::format("line {}:", line)) != std::string::npos;
 }
 
-void expect_error_at(const Outcome& o, int line, const std::string& key,
-                     const std::vector<std::string>& also = {}) {
+void expect_error_at(const Outcome& o, int line, const std::string& key, const std::vector<std::string>& also = {}) {
   EXPECT_TRUE(names_line(o.err, line)) << "expected line " << line << ": " << o.err;
   expect_input_error(o, key, also);
 }
@@ -138,8 +135,8 @@ TEST(InputErrors, UnknownPressureDivergence) {
 
 TEST(InputErrors, IncrementalProjectionWithStressPointDivergence) {
   test::TempDir dir;
-  const std::string text = replace(kBase, "[time]",
-                                   "[solver]\npressure_divergence = \"stress_points\"\npressure_incremental = true\n[time]");
+  const std::string text = replace(
+      kBase, "[time]", "[solver]\npressure_divergence = \"stress_points\"\npressure_incremental = true\n[time]");
   const auto o = run_case_text(dir, text);
   expect_error_at(o, line_of(text, "pressure_incremental"), "solver.pressure_incremental", {"unstable"});
 }

@@ -30,9 +30,9 @@ TEST(SetOverride, ArrayOfTablesIndexAndNestedKey) {
   ASSERT_EQ(plain.boundaries[1].stress.size(), 1u);
   EXPECT_EQ(plain.boundaries[1].stress[0].second, 1.0e4);
 
-  const auto c = read_case<1>(load_case_document(
-      kBar, {"boundary.1.stress.xx=-2.5e4", "functions.load.type=smoothstep",
-             "functions.load.duration=0.04", "geometry.spacing=0.05", "material.E=2e7"}));
+  const auto c = read_case<1>(
+      load_case_document(kBar, {"boundary.1.stress.xx=-2.5e4", "functions.load.type=smoothstep",
+                                "functions.load.duration=0.04", "geometry.spacing=0.05", "material.E=2e7"}));
   ASSERT_EQ(c.boundaries.size(), 2u);
   EXPECT_EQ(c.boundaries[1].stress[0].first, 0);  // xx
   EXPECT_EQ(c.boundaries[1].stress[0].second, -2.5e4);
@@ -95,7 +95,8 @@ TEST(SetOverride, BadPaths) {
 
 TEST(Section, WhereNamesFileLineAndDottedKey) {
   test::TempDir dir;
-  const std::string path = dir.write("s.toml", "a = 1\n\n[outer]\nx = 2.5\n\n[[outer.list]]\ny = \"s\"\n\n[[outer.list]]\ny = 3\n");
+  const std::string path =
+      dir.write("s.toml", "a = 1\n\n[outer]\nx = 2.5\n\n[[outer.list]]\ny = \"s\"\n\n[[outer.list]]\ny = 3\n");
   const auto doc = load_case_document(path, {});
   io::Section root(doc.table, "", doc.file_label);
   EXPECT_EQ(root.where("a"), path + ", line 1, key 'a'");

@@ -54,9 +54,7 @@ bool is_scalar(const std::string& shape, long n) {
   return shape == std::to_string(n) || shape == std::to_string(n) + " 1";
 }
 
-bool have_meshio() {
-  return test::run_command(fmt::format("{} -c 'import meshio' 2>/dev/null", kPython)).status == 0;
-}
+bool have_meshio() { return test::run_command(fmt::format("{} -c 'import meshio' 2>/dev/null", kPython)).status == 0; }
 
 VtuInfo read_vtu(const std::string& path) {
   const std::string script =
@@ -92,7 +90,8 @@ TEST(VtuOutput, ReadBackByMeshioAndPvdListsEveryFrame) {
   test::TempDir dir;
   const std::string file = dir.write("tiny.toml", kCase);
   const std::string out = dir.file("out");
-  const auto r = test::run_command(fmt::format("\"{}\" run \"{}\" --out \"{}\" -q -j 1 2>&1", RKTSPH_BINARY, file, out));
+  const auto r =
+      test::run_command(fmt::format("\"{}\" run \"{}\" --out \"{}\" -q -j 1 2>&1", RKTSPH_BINARY, file, out));
   ASSERT_EQ(r.status, 0) << r.out;
 
   const auto summary = nlohmann::json::parse(test::read_text(out + "/summary.json"));

@@ -5,15 +5,14 @@
 
 #include <toml++/toml.h>
 
-#include "io/section.hpp"
 #include "case/material_reader.hpp"
+#include "io/section.hpp"
 #include "materials/material.hpp"
 
 namespace rktsph::test {
 
 /// Build a model from the body of a [material] table, as a case file would.
-inline std::unique_ptr<Material> material_from_toml(const std::string& body,
-                                                    const std::string& file = "test.toml") {
+inline std::unique_ptr<Material> material_from_toml(const std::string& body, const std::string& file = "test.toml") {
   const toml::table root = toml::parse("[material]\n" + body, file);
   const io::Section top(root, "", std::make_shared<const std::string>(file));
   const io::Section mat = top.table("material");
@@ -25,7 +24,8 @@ inline std::unique_ptr<Material> material_from_toml(const std::string& body,
 /// von Mises, E = 10 MPa, nu = 0.3, Y = 100 kPa, with the given fluidity (1/s) and extra keys.
 inline std::string von_mises(double fluidity, const std::string& extra = "") {
   return "model = 'perzyna_von_mises'\nE = 1.0e7\nnu = 0.3\ndensity = 2000.0\n"
-         "yield_stress = 1.0e5\nfluidity = " + std::to_string(fluidity) + "\n" + extra;
+         "yield_stress = 1.0e5\nfluidity = " +
+         std::to_string(fluidity) + "\n" + extra;
 }
 
 inline const std::string kCamClayCase3 =

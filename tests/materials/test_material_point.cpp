@@ -41,8 +41,8 @@ std::string with(const std::string& key, const std::string& line) {
   return m + kGoodRest;
 }
 
-void expect_input_error(const std::string& name, const std::string& text,
-                        const std::string& key, const std::string& phrase = "") {
+void expect_input_error(const std::string& name, const std::string& text, const std::string& key,
+                        const std::string& phrase = "") {
   const std::string file = write_case(name, text);
   try {
     load_material_point_case(file, {});
@@ -68,43 +68,42 @@ TEST(MaterialPointCase, GoodCaseLoads) {
 }
 
 TEST(MaterialPointCase, BadMaterialInputNamesKeyAndFile) {
-  expect_input_error("mp_lk.toml", with("kappa", "kappa = 0.3"), "material.kappa",
-                     "negative lambda-kappa");
+  expect_input_error("mp_lk.toml", with("kappa", "kappa = 0.3"), "material.kappa", "negative lambda-kappa");
   expect_input_error("mp_pc.toml", with("p_c0", "p_c0 = -5"), "material.p_c0");
   expect_input_error("mp_M.toml", with("M", "M = 0"), "material.M");
   expect_input_error("mp_fl.toml", with("fluidity", "fluidity = 0"), "material.fluidity");
   expect_input_error("mp_N.toml", with("exponent", "exponent = -1"), "material.exponent");
-  expect_input_error("mp_os.toml", with("overstress", "overstress = 'cubic'"),
-                     "material.overstress", "cubic");
+  expect_input_error("mp_os.toml", with("overstress", "overstress = 'cubic'"), "material.overstress", "cubic");
   expect_input_error("mp_ocr.toml", with("ocr", "ocr = 2"), "material.ocr", "exactly one");
-  expect_input_error("mp_typo.toml", with("lamda", "lamda = 0.2"), "material.lamda",
-                     "unknown key");
+  expect_input_error("mp_typo.toml", with("lamda", "lamda = 0.2"), "material.lamda", "unknown key");
   expect_input_error("mp_model.toml", with("model", "model = 'cam_clay'"), "material.model");
   const std::string vm =
       "[material]\nmodel = 'perzyna_von_mises'\nE = 1e7\nnu = 0.3\ndensity = 2000\n"
       "fluidity = 1\n";
   const std::string rest = "[path]\ntype = 'simple_shear'\nshear_strain_rate = 1\nduration = 1\n";
   expect_input_error("mp_vm_none.toml", vm + rest, "material.yield_stress", "exactly one");
-  expect_input_error("mp_vm_both.toml", vm + "yield_stress = 1e5\ncohesion = 5e4\n" + rest,
-                     "material.cohesion", "exactly one");
+  expect_input_error("mp_vm_both.toml", vm + "yield_stress = 1e5\ncohesion = 5e4\n" + rest, "material.cohesion",
+                     "exactly one");
   expect_input_error("mp_vm_res.toml", vm + "yield_stress = 1e5\nresidual_yield_stress = 2e5\n" + rest,
                      "material.residual_yield_stress");
 }
 
 TEST(MaterialPointCase, BadPathInputNamesKeyAndFile) {
-  expect_input_error("mp_type.toml", kGoodMaterial + "[path]\ntype = 'triaxial'\nduration = 1\n",
-                     "path.type", "triaxial");
+  expect_input_error("mp_type.toml", kGoodMaterial + "[path]\ntype = 'triaxial'\nduration = 1\n", "path.type",
+                     "triaxial");
   expect_input_error("mp_dur.toml",
-                     kGoodMaterial + "[path]\ntype = 'oedometric'\naxial_strain_rate = -1\n"
-                                     "duration = 0\n",
+                     kGoodMaterial +
+                         "[path]\ntype = 'oedometric'\naxial_strain_rate = -1\n"
+                         "duration = 0\n",
                      "path.duration");
   expect_input_error("mp_rate.toml", kGoodMaterial + "[path]\ntype = 'oedometric'\nduration = 1\n",
                      "path.axial_strain_rate", "missing");
   expect_input_error("mp_both.toml",
-                     kGoodMaterial + "[initial]\nstress = {xx = -1e5, yy = -1e5, zz = -1e5}\n"
-                                     "[path]\ntype = 'strain_rate'\nduration = 1\n"
-                                     "strain_rate = {yy = -0.01, xx = 0.0}\n"
-                                     "stress_rate = {xx = 0.0}\n",
+                     kGoodMaterial +
+                         "[initial]\nstress = {xx = -1e5, yy = -1e5, zz = -1e5}\n"
+                         "[path]\ntype = 'strain_rate'\nduration = 1\n"
+                         "strain_rate = {yy = -0.01, xx = 0.0}\n"
+                         "stress_rate = {xx = 0.0}\n",
                      "path.stress_rate.xx", "not both");
   // OCR with a tensile initial stress cannot define p_c.
   std::string t = with("p_c0", "ocr = 2");
@@ -142,8 +141,8 @@ TEST(MaterialPointCase, RunWritesCsvWithTheDocumentedHeader) {
 }
 
 TEST(MaterialPointCase, ExampleCasesLoad) {
-  for (const char* name : {"von_mises_shear.toml", "cam_clay_drained_nc.toml",
-                           "cam_clay_undrained_nc.toml", "cam_clay_case3_biaxial.toml"}) {
+  for (const char* name : {"von_mises_shear.toml", "cam_clay_drained_nc.toml", "cam_clay_undrained_nc.toml",
+                           "cam_clay_case3_biaxial.toml"}) {
     const std::string f = std::string(RKTSPH_SOURCE_DIR) + "/cases/material_point/" + name;
     EXPECT_NO_THROW(load_material_point_case(f, {})) << name;
   }

@@ -64,8 +64,7 @@ TEST(VonMisesPerzyna, SteadyStateUnderConstantDeviatoricStrainRate) {
   const Variant variants[] = {
       {"exponent = 1.0\n", kY * (1.0 + rate_eq / gamma)},
       {"exponent = 2.0\n", kY * (1.0 + std::sqrt(rate_eq / gamma))},
-      {"exponent = 2.0\noverstress = 'exponential'\n",
-       kY * (1.0 + std::log1p(rate_eq / gamma) / 2.0)},
+      {"exponent = 2.0\noverstress = 'exponential'\n", kY * (1.0 + std::log1p(rate_eq / gamma) / 2.0)},
   };
   for (const Variant& v : variants) {
     auto m = material_from_toml(test::von_mises(gamma, v.keys));
@@ -102,8 +101,7 @@ TEST(VonMisesPerzyna, StressRelaxationDecaysAtTheMethodRate) {
   }
   const PathPoint& a = r.points[50];
   const PathPoint& b = r.points[150];
-  const double measured =
-      std::log((q_of(a.stress) - kY) / (q_of(b.stress) - kY)) / (b.t - a.t);
+  const double measured = std::log((q_of(a.stress) - kY) / (q_of(b.stress) - kY)) / (b.t - a.t);
   EXPECT_NEAR(measured, rate, 1e-5 * rate);
   // The relaxed stress went into eps_vp_eq: q0 - q = 3 G eps_vp_eq.
   EXPECT_NEAR(r.points.back().state[0], (q0 - q_of(r.points.back().stress)) / (3.0 * kG), 1e-12);
@@ -111,8 +109,8 @@ TEST(VonMisesPerzyna, StressRelaxationDecaysAtTheMethodRate) {
 
 // Independent rate-independent reference: incremental radial return (backward Euler) for von
 // Mises with linear hardening, many small increments along the same strain path.
-Sym6 radial_return_reference(const Sym6& sigma0, const Sym6& eps_rate, double duration,
-                             double E, double nu, double Y0, double H, int increments) {
+Sym6 radial_return_reference(const Sym6& sigma0, const Sym6& eps_rate, double duration, double E, double nu, double Y0,
+                             double H, int increments) {
   const double G = E / (2 * (1 + nu)), K = E / (3 * (1 - 2 * nu));
   const double dt = duration / increments;
   Sym6 s = sigma0;
@@ -166,8 +164,8 @@ TEST(VonMisesPerzyna, FastLimitApproachesRateIndependentReturnMapping) {
 }
 
 // One particle advanced by the batch integrator (the solver's entry point).
-Sym6 advance(const Material& m, const Sym6& s0, const Sym6& flux, double tau,
-             SourceCoupling coupling, std::vector<double>& k, SourceStats* stats = nullptr) {
+Sym6 advance(const Material& m, const Sym6& s0, const Sym6& flux, double tau, SourceCoupling coupling,
+             std::vector<double>& k, SourceStats* stats = nullptr) {
   Sym6 out{};
   std::vector<double> kend(k.size());
   SourceBatch b;
@@ -214,8 +212,7 @@ TEST(PerzynaSource, SubSteppingKeepsStiffSourceBoundedAndAccurate) {
   b.state_start = k0;
   b.state_end = k1;
   detail::integrate_source_batch(
-      tau, b, 1,
-      [pm](const Sym6& a, const double* kk, Sym6& ds, double* dk) { pm->source_rate(a, kk, ds, dk); },
+      tau, b, 1, [pm](const Sym6& a, const double* kk, Sym6& ds, double* dk) { pm->source_rate(a, kk, ds, dk); },
       [](const Sym6&, const double*) { return 0.0; });
   EXPECT_GT(std::abs(q_of(out) - kY), 1e3 * kY);
 }
@@ -362,8 +359,8 @@ const std::string kCamClayNC =
 TEST(CamClayPerzyna, DrainedTriaxialNormallyConsolidatedEndsOnCriticalState) {
   auto m = material_from_toml(kCamClayNC);
   LoadPath path = LoadPath::drained_triaxial(-0.01);
-  path.duration = 80.0;  // 80 % axial strain (small-strain model): the approach is exponential
-  path.dt = 0.05;        // in strain with a scale of about 12 %
+  path.duration = 80.0;          // 80 % axial strain (small-strain model): the approach is exponential
+  path.dt = 0.05;                // in strain with a scale of about 12 %
   path.relaxation_target = 2.0;  // stable for RK4 (2.78); the stiff mode only tracks the surface
   const Sym6 s0{-1e5, -1e5, -1e5, 0, 0, 0};
   const PathResult r = integrate_path(*m, s0, path);

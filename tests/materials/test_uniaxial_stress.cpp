@@ -18,8 +18,7 @@ std::unique_ptr<Material> wrapped(double fluidity, const std::string& extra = ""
 }
 
 // Advance one particle (1D layout: sxx, syy, szz) over tau with a constant flux rate r_xx.
-double advance(const Material& m, double sxx, double r_xx, double tau, double* state,
-               SourceCoupling coupling) {
+double advance(const Material& m, double sxx, double r_xx, double tau, double* state, SourceCoupling coupling) {
   const double s0[3] = {sxx, 0.0, 0.0};
   const double r[3] = {r_xx, 0.0, 0.0};
   double s1[3] = {};

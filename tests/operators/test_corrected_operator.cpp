@@ -12,8 +12,8 @@
 #include <fmt/format.h>
 
 #include "core/kernel.hpp"
-#include "particles/lattice.hpp"
 #include "operators/corrected_operator.hpp"
+#include "particles/lattice.hpp"
 
 namespace rktsph {
 namespace {
@@ -189,9 +189,8 @@ TEST(CorrectedOperator, ExactAtArbitraryPointsNearCornersOfAnLShape) {
   b.max = Vec<2>(2, 4);
   const auto disc = generate_lattice<2>({a, b}, dx, Vec<2>(0, 0), {1800.0});
   const CubicSplineKernel<2> kernel(1.2 * dx);
-  const std::vector<Vec<2>> pts = {Vec<2>(0, 0),     Vec<2>(4, 0),   Vec<2>(4, 2),
-                                   Vec<2>(2, 4),     Vec<2>(0, 4),   Vec<2>(2, 2),
-                                   Vec<2>(2.1, 2.1), Vec<2>(0.13, 3.9), Vec<2>(3.3, 0.07)};
+  const std::vector<Vec<2>> pts = {Vec<2>(0, 0), Vec<2>(4, 0),     Vec<2>(4, 2),      Vec<2>(2, 4),     Vec<2>(0, 4),
+                                   Vec<2>(2, 2), Vec<2>(2.1, 2.1), Vec<2>(0.13, 3.9), Vec<2>(3.3, 0.07)};
   const Field<2> lin = [](const Vec<2>& x) { return 4.0 + 0.5 * x[0] - 1.25 * x[1]; };
   auto glin = [](const Vec<2>&) { return Vec<2>(0.5, -1.25); };
   for (const auto* set : {&disc.nodes, &disc.stress_points}) {

@@ -11,9 +11,9 @@
 #include <random>
 
 #include "core/kernel.hpp"
-#include "particles/lattice.hpp"
 #include "operators/corrected_operator.hpp"
 #include "operators/laplacian.hpp"
+#include "particles/lattice.hpp"
 
 namespace rktsph {
 namespace {
@@ -155,7 +155,7 @@ TEST(Laplacian, MirrorWallsRestoreTheFullSupportIn2D) {
   for (Index i = 0; i < s.size(); ++i) {
     const Vec<2>& x = s.position[static_cast<std::size_t>(i)];
     const double far = 1.4 - 2.0 * kernel.h() - 0.5 * dx;
-    if (x[0] > far || x[1] > far) continue;                          // away from the open sides
+    if (x[0] > far || x[1] > far) continue;                            // away from the open sides
     if (x[0] < 2.0 * kernel.h() && x[1] < 2.0 * kernel.h()) continue;  // corner region
     worst = std::max(worst, std::abs(Lf[i] - 4.0) / 4.0);
     worst_plain = std::max(worst_plain, std::abs(Pf[i] - 4.0) / 4.0);

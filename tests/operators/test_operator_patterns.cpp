@@ -15,8 +15,8 @@
 
 #include "../support/test_util.hpp"
 #include "core/kernel.hpp"
-#include "particles/lattice.hpp"
 #include "operators/corrected_operator.hpp"
+#include "particles/lattice.hpp"
 
 namespace rktsph {
 namespace {
@@ -77,7 +77,8 @@ Agreement compare(const CorrectedOperator<Dim>& op, const CorrectedOperator<Dim>
     double wmax = 0.0, gmax = 0.0;
     for (Index k = q.begin; k < q.end; ++k) {
       wmax = std::max(wmax, std::abs(ref.interp[static_cast<std::size_t>(k)]));
-      for (int d = 0; d < Dim; ++d) gmax = std::max(gmax, std::abs(ref.grad[static_cast<std::size_t>(k)][static_cast<std::size_t>(d)]));
+      for (int d = 0; d < Dim; ++d)
+        gmax = std::max(gmax, std::abs(ref.grad[static_cast<std::size_t>(k)][static_cast<std::size_t>(d)]));
     }
     double val = 0.0, val_ref = 0.0, val_scale = 0.0;
     double g[Dim] = {}, g_ref[Dim] = {}, g_scale[Dim] = {};

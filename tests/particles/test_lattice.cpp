@@ -64,13 +64,13 @@ TEST(Discretise, TributaryVolumes) {
   const double dx = 0.5, c = dx * dx;
   const auto d = l_shape(dx);
   auto vol = [&](double x, double y) { return d.nodes.volume[static_cast<std::size_t>(find_node(d, x, y))]; };
-  EXPECT_DOUBLE_EQ(vol(1.0, 1.0), c);          // interior
-  EXPECT_DOUBLE_EQ(vol(2.0, 1.5), c);          // interior (below the re-entrant corner)
-  EXPECT_DOUBLE_EQ(vol(1.5, 0.0), c / 2);      // bottom edge
-  EXPECT_DOUBLE_EQ(vol(0.0, 3.0), c / 2);      // left edge
-  EXPECT_DOUBLE_EQ(vol(3.0, 2.0), c / 2);      // top edge of the lower block
-  EXPECT_DOUBLE_EQ(vol(2.0, 3.0), c / 2);      // right edge of the upper block
-  EXPECT_DOUBLE_EQ(vol(0.0, 0.0), c / 4);      // convex corners
+  EXPECT_DOUBLE_EQ(vol(1.0, 1.0), c);      // interior
+  EXPECT_DOUBLE_EQ(vol(2.0, 1.5), c);      // interior (below the re-entrant corner)
+  EXPECT_DOUBLE_EQ(vol(1.5, 0.0), c / 2);  // bottom edge
+  EXPECT_DOUBLE_EQ(vol(0.0, 3.0), c / 2);  // left edge
+  EXPECT_DOUBLE_EQ(vol(3.0, 2.0), c / 2);  // top edge of the lower block
+  EXPECT_DOUBLE_EQ(vol(2.0, 3.0), c / 2);  // right edge of the upper block
+  EXPECT_DOUBLE_EQ(vol(0.0, 0.0), c / 4);  // convex corners
   EXPECT_DOUBLE_EQ(vol(4.0, 0.0), c / 4);
   EXPECT_DOUBLE_EQ(vol(4.0, 2.0), c / 4);
   EXPECT_DOUBLE_EQ(vol(2.0, 4.0), c / 4);

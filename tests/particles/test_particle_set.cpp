@@ -82,7 +82,8 @@ TEST(BoundaryNodes, RemapFollowsAPermutationOfTheNodes) {
   lat.nodes.permute(order);
   lat.boundary.remap(order);
   const auto after = lat.boundary.dense_faces(n);
-  for (Index k = 0; k < n; ++k) EXPECT_EQ(after[static_cast<std::size_t>(k)], before[static_cast<std::size_t>(n - 1 - k)]);
+  for (Index k = 0; k < n; ++k)
+    EXPECT_EQ(after[static_cast<std::size_t>(k)], before[static_cast<std::size_t>(n - 1 - k)]);
   EXPECT_TRUE(std::is_sorted(lat.boundary.node.begin(), lat.boundary.node.end()));
 }
 

@@ -53,9 +53,8 @@ TEST(SchemeRegistry, BuiltInSchemesAreListsOfNamedStages) {
   test::TempDir dir;
   Simulation<2> v1(test::case_from_string<2>(dir, kBlock));
   EXPECT_EQ(v1.scheme().name(), "v1");
-  EXPECT_EQ(stage_names(v1.scheme()),
-            (std::vector<std::string>{"stress_points_half_step", "nodes_full_step", "constraints", "velocity_filter",
-                                      "constraints"}));
+  EXPECT_EQ(stage_names(v1.scheme()), (std::vector<std::string>{"stress_points_half_step", "nodes_full_step",
+                                                                "constraints", "velocity_filter", "constraints"}));
   const auto names = scheme_names<2>();
   EXPECT_NE(std::find(names.begin(), names.end(), "v1"), names.end());
   EXPECT_NE(std::find(names.begin(), names.end(), "v3"), names.end());

@@ -16,8 +16,8 @@ namespace {
 TEST(Energy, BarUnderSmoothLoadBalancesWithinOnePercent) {
   const test::ThreadCount threads(1);
   const std::string file = std::string(RKTSPH_SOURCE_DIR) + "/cases/thesis/01_elastic_bar_1d.toml";
-  auto setup = read_case<1>(load_case_document(
-      file, {"functions.load.type=smoothstep", "functions.load.duration=0.0353553"}));
+  auto setup =
+      read_case<1>(load_case_document(file, {"functions.load.type=smoothstep", "functions.load.duration=0.0353553"}));
   const double L = 10.0, E = 1.0e7, sigma0 = 1.0e4;
   Simulation<1> solver(setup);
   ASSERT_EQ(solver.nodes().size(), 101);
@@ -30,9 +30,10 @@ TEST(Energy, BarUnderSmoothLoadBalancesWithinOnePercent) {
     worst = std::max(worst, std::abs(e.imbalance()));
     max_work = std::max(max_work, e.external_work);
   }
-  std::printf("1D bar, smooth load, N = 100, to 3.5 L/c: max |imbalance| = %.4g J = %.3g %% of %.0f J "
-              "(external work up to %.4g J)\n",
-              worst, 100.0 * worst / scale, scale, max_work);
+  std::printf(
+      "1D bar, smooth load, N = 100, to 3.5 L/c: max |imbalance| = %.4g J = %.3g %% of %.0f J "
+      "(external work up to %.4g J)\n",
+      worst, 100.0 * worst / scale, scale, max_work);
   EXPECT_GT(max_work, 0.25 * scale) << "the load did no work: the test would be vacuous";
   EXPECT_LT(worst, 0.01 * scale);
 }
@@ -76,9 +77,10 @@ cfl = 0.9
       max_work = std::max(max_work, std::abs(e.external_work));
     }
   }
-  std::printf("2D block, gravity ramp, undamped, to 0.5 s: max |imbalance| = %.4g J = %.3g %% of "
-              "the max external work %.4g J\n",
-              worst, 100.0 * worst / max_work, max_work);
+  std::printf(
+      "2D block, gravity ramp, undamped, to 0.5 s: max |imbalance| = %.4g J = %.3g %% of "
+      "the max external work %.4g J\n",
+      worst, 100.0 * worst / max_work, max_work);
   EXPECT_GT(max_work, 0.0);
   EXPECT_LT(worst, 0.03 * max_work);
 }

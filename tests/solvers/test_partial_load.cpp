@@ -40,7 +40,8 @@ velocity = { x = 0.0 }
 name = "base"
 y = [0.0, 0.0]
 velocity = { y = 0.0 }
-)" + loads + R"(
+)" + loads +
+         R"(
 [time]
 end = 10.0
 cfl = 0.5

@@ -63,8 +63,7 @@ struct Drift {
 
 // Seed the uniform stress at every node (the boundary values already hold it), run, measure.
 template <int Dim>
-Drift run_patch(Simulation<Dim>& solver, const std::array<double, kStressComponents<Dim>>& s0,
-                int steps) {
+Drift run_patch(Simulation<Dim>& solver, const std::array<double, kStressComponents<Dim>>& s0, int steps) {
   auto stress = solver.mutable_node_stress();
   const auto nn = static_cast<std::size_t>(solver.nodes().size());
   for (std::size_t i = 0; i < nn; ++i) {

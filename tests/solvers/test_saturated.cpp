@@ -7,19 +7,19 @@
 
 #include <algorithm>
 #include <cmath>
-#include <string>
-#include <utility>
 #include <iostream>
 #include <random>
+#include <string>
+#include <utility>
 
-#include <Eigen/Dense>
 #include <fmt/format.h>
+#include <Eigen/Dense>
 
 #include "../support/test_util.hpp"
 #include "core/error.hpp"
 #include "core/kernel.hpp"
-#include "operators/laplacian.hpp"
 #include "linear_solvers/pore_pressure.hpp"
+#include "operators/laplacian.hpp"
 #include "schemes/simulation.hpp"
 #include "validation/analytic_saturated.hpp"
 
@@ -432,9 +432,10 @@ TEST(Saturated, IncrementalProjectionReducesTheUndrainedPressureLeakUnderGravity
   EXPECT_LT(inc[0] - inc[2], 0.25 * (non[0] - non[2]));
   EXPECT_GT(non[0] - non[2], 0.1 * p_ref);  // the leak of the default, on record
   RecordProperty("non_incremental_base_pw_over_ref_at_3s", std::to_string(non[2] / p_ref));
-  std::cerr << fmt::format("undrained strip, base p_w / reference at t = 1, 2, 3 s: incremental {:.4f} {:.4f} {:.4f}, "
-                           "non-incremental {:.4f} {:.4f} {:.4f}\n",
-                           inc[0] / p_ref, inc[1] / p_ref, inc[2] / p_ref, non[0] / p_ref, non[1] / p_ref, non[2] / p_ref);
+  std::cerr << fmt::format(
+      "undrained strip, base p_w / reference at t = 1, 2, 3 s: incremental {:.4f} {:.4f} {:.4f}, "
+      "non-incremental {:.4f} {:.4f} {:.4f}\n",
+      inc[0] / p_ref, inc[1] / p_ref, inc[2] / p_ref, non[0] / p_ref, non[1] / p_ref, non[2] / p_ref);
 }
 
 TEST(Saturated, PressureFilterKeepsTheUndrainedPressureUnderGravity) {
@@ -444,8 +445,9 @@ TEST(Saturated, PressureFilterKeepsTheUndrainedPressureUnderGravity) {
   const auto inc = undrained_strip_base_pressure(true);
   const auto fil = undrained_strip_base_pressure(true, 1.0);
   for (std::size_t k = 0; k < fil.size(); ++k) EXPECT_NEAR(fil[k], inc[k], 0.01 * p_ref);
-  std::cerr << fmt::format("undrained strip, base p_w / reference at t = 1, 2, 3 s: incremental + filter {:.4f} {:.4f} {:.4f}\n",
-                           fil[0] / p_ref, fil[1] / p_ref, fil[2] / p_ref);
+  std::cerr << fmt::format(
+      "undrained strip, base p_w / reference at t = 1, 2, 3 s: incremental + filter {:.4f} {:.4f} {:.4f}\n",
+      fil[0] / p_ref, fil[1] / p_ref, fil[2] / p_ref);
 }
 
 // Largest odd-even (checkerboard) amplitude of p_w over the nodes of a lattice block.
@@ -513,8 +515,10 @@ TEST(Saturated, PressureFilterDampsTheCheckerboardThatTheIncrementalProjectionKe
   EXPECT_GT(incremental, 0.5);
   EXPECT_LT(filtered, 0.01);
   EXPECT_LT(projection, 0.01);
-  std::cerr << fmt::format("checkerboard left after 20 steps: incremental {:.3g}, incremental + filter {:.3g}, "
-                           "non-incremental {:.3g}\n", incremental, filtered, projection);
+  std::cerr << fmt::format(
+      "checkerboard left after 20 steps: incremental {:.3g}, incremental + filter {:.3g}, "
+      "non-incremental {:.3g}\n",
+      incremental, filtered, projection);
 }
 
 // The known V3 instability (docs/VALIDATION.md, Case 16): impermeable faces carrying a total
@@ -579,8 +583,10 @@ cfl = {}
       message = e.what();
     }
     double vmax = 0.0;
-    for (double v : values_of(solver.model().nodes.view(solver.model().fields.velocity))) vmax = std::max(vmax, std::abs(v));
-    for (double s : values_of(solver.model().nodes.view(solver.model().fields.stress))) vmax = std::max(vmax, std::abs(s));
+    for (double v : values_of(solver.model().nodes.view(solver.model().fields.velocity)))
+      vmax = std::max(vmax, std::abs(v));
+    for (double s : values_of(solver.model().nodes.view(solver.model().fields.stress)))
+      vmax = std::max(vmax, std::abs(s));
     return std::make_pair(message, vmax);
   };
   const auto [unstable, v_unstable] = run(0.5);

@@ -83,8 +83,8 @@ Result run(int threads, int steps) {
   Simulation<2> solver(setup);
   EXPECT_EQ(solver.nodes().size(), 33 * 33);
   for (int n = 0; n < steps; ++n) solver.step();
-  std::printf("%d thread(s): %d steps in %.3f s, max source sub-steps %ld\n", threads, steps,
-              omp_get_wtime() - t0, solver.max_source_substeps());
+  std::printf("%d thread(s): %d steps in %.3f s, max source sub-steps %ld\n", threads, steps, omp_get_wtime() - t0,
+              solver.max_source_substeps());
   const auto& m = solver.model();
   return {values_of(m.nodes.view(m.fields.velocity)),
           values_of(m.nodes.view(m.fields.stress)),
@@ -105,7 +105,8 @@ TEST(Threads, OneAndTwoThreadsGiveBitIdenticalResults) {
   const Result two = run(2, steps);
   // The run did something: the soft layer yielded and the state is far from zero.
   double vmax = 0.0;
-  for (std::size_t i = 0; i < one.node_velocity.size(); i += 2) vmax = std::max(vmax, std::abs(one.node_velocity[i + 1]));
+  for (std::size_t i = 0; i < one.node_velocity.size(); i += 2)
+    vmax = std::max(vmax, std::abs(one.node_velocity[i + 1]));
   EXPECT_GT(vmax, 1e-4);
   double hmax = 0.0;
   for (double h : one.history) hmax = std::max(hmax, std::abs(h));

@@ -20,8 +20,8 @@ namespace {
 
 template <int Dim>
 CaseSetup<Dim> setup_from(const std::string& text, const std::string& tag) {
-  const auto path = std::filesystem::temp_directory_path() /
-                    ("rktsph_uniform_" + tag + "_" + std::to_string(::getpid()) + ".toml");
+  const auto path =
+      std::filesystem::temp_directory_path() / ("rktsph_uniform_" + tag + "_" + std::to_string(::getpid()) + ".toml");
   {
     std::ofstream f(path);
     f << text;

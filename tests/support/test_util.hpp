@@ -5,6 +5,7 @@
 #include <omp.h>
 #include <unistd.h>
 
+#include <sys/wait.h>
 #include <array>
 #include <cstdio>
 #include <cstdlib>
@@ -12,7 +13,6 @@
 #include <fstream>
 #include <memory>
 #include <string>
-#include <sys/wait.h>
 #include <vector>
 
 #include "case/case_reader.hpp"
@@ -28,8 +28,7 @@ class TempDir {
     for (char& c : name) {
       if (c == '/') c = '_';
     }
-    path_ = std::filesystem::temp_directory_path() /
-            ("rktsph_test_" + std::to_string(::getpid()) + "_" + name);
+    path_ = std::filesystem::temp_directory_path() / ("rktsph_test_" + std::to_string(::getpid()) + "_" + name);
     std::filesystem::remove_all(path_);
     std::filesystem::create_directories(path_);
   }
@@ -58,8 +57,7 @@ class TempDir {
 /// Read a case from a TOML string, through the public path (file -> document -> setup).
 template <int Dim>
 CaseSetup<Dim> case_from_string(const TempDir& dir, const std::string& toml,
-                                const std::vector<std::string>& overrides = {},
-                                const std::string& name = "case.toml") {
+                                const std::vector<std::string>& overrides = {}, const std::string& name = "case.toml") {
   const std::string path = dir.write(name, toml);
   return read_case<Dim>(load_case_document(path, overrides));
 }
@@ -92,8 +90,10 @@ inline CommandResult run_command(const std::string& command) {
   std::size_t n = 0;
   while ((n = std::fread(buf.data(), 1, buf.size(), pipe)) > 0) r.out.append(buf.data(), n);
   const int raw = ::pclose(pipe);
-  if (WIFEXITED(raw)) r.status = WEXITSTATUS(raw);
-  else if (WIFSIGNALED(raw)) r.status = 128 + WTERMSIG(raw);
+  if (WIFEXITED(raw))
+    r.status = WEXITSTATUS(raw);
+  else if (WIFSIGNALED(raw))
+    r.status = 128 + WTERMSIG(raw);
   return r;
 }
 

@@ -40,8 +40,8 @@ TEST(CutClassification, SyntheticHistories) {
   EXPECT_LT(c.ke_ratio, 1e-2);
 
   // Displacement at rest but still ringing (kinetic energy only 10x below its peak): not stable.
-  auto ringing = make([](double t) { return 2e-3 * std::min(t, 3.0) / 3.0; },
-                      [](double t) { return t < 3.0 ? 100.0 : 10.0; });
+  auto ringing =
+      make([](double t) { return 2e-3 * std::min(t, 3.0) / 3.0; }, [](double t) { return t < 3.0 ? 100.0 : 10.0; });
   EXPECT_NE(classify_cut(ringing.t, ringing.uc, ringing.ke, kH).outcome, CutOutcome::stable);
 
   // Large crest displacement: collapse.
