@@ -6,47 +6,67 @@ namespace rktsph::io {
 
 template <int Dim>
 FieldCatalogue<Dim>::FieldCatalogue(const Simulation<Dim>& sim, Set set) {
-  const bool nodes = set == Set::nodes;
-  const ParticleSet<Dim>& particles = nodes ? sim.nodes() : sim.stress_points();
+  const ParticleSet<Dim>& particles = set == Set::nodes ? sim.nodes() : sim.stress_points();
   size_ = particles.size();
-  auto vector = [&](std::string name, const char* prefix, VectorView<Dim> v) {
-    fields_.push_back({std::move(name), 3, [v](Index i, int c) { return c < Dim ? v(i, c) : 0.0; }});
-    for (int d = 0; d < Dim; ++d) {
-      scalars_.push_back(
-          {fmt::format("{}{}", prefix, kAxisNames[static_cast<std::size_t>(d)]), [v, d](Index i) { return v(i, d); }});
-    }
-  };
   auto scalar = [&](std::string name, ScalarField f) {
     fields_.push_back({name, 1, [f](Index i, int) { return f(i); }});
     scalars_.push_back({std::move(name), std::move(f)});
   };
-
-  vector("velocity", "v", nodes ? sim.node_velocity() : sim.stress_point_velocity());
-  if (nodes) vector("displacement", "u", sim.node_displacement());
-  const StressView<Dim> stress = nodes ? sim.node_stress() : sim.stress_point_stress();
-  for (std::size_t c = 0; c < 6; ++c) {
-    const auto comp = static_cast<StressComponent>(c);
-    if (stress_slot<Dim>(comp) < 0) continue;
-    scalar(fmt::format("s{}", kStressComponentNames[c]), [stress, comp](Index i) { return stress(i, comp); });
-  }
-  scalar("p", [stress](Index i) { return stress.invariants(i).p; });
-  scalar("q", [stress](Index i) { return stress.invariants(i).q; });
-  for (const std::string& name : sim.history_layout().names()) {
-    const HistoryView h = nodes ? sim.node_history(name) : sim.stress_point_history(name);
-    scalar(name, [h](Index i) { return h(i); });
-  }
-  if (nodes && sim.saturated()) {
-    // V3: pore pressure (compression positive) and the total stresses sigma' - p_w 1; the
-    // stress fields above are effective stresses.
-    const std::span<const double> pw = sim.node_pore_pressure();
-    scalar("pw", [pw](Index i) { return pw[static_cast<std::size_t>(i)]; });
-    for (std::size_t c = 0; c < 6; ++c) {
-      const auto comp = static_cast<StressComponent>(c);
-      if (stress_slot<Dim>(comp) < 0) continue;
-      const bool normal = c < 3;
-      scalar(fmt::format("total_s{}", kStressComponentNames[c]), [stress, comp, pw, normal](Index i) {
-        return stress(i, comp) - (normal ? pw[static_cast<std::size_t>(i)] : 0.0);
-      });
+  // Every field declared for output, by its kind (particles/field.hpp), in declaration order.
+  std::optional<StressView<Dim>> stress;
+  for (const FieldInfo& info : particles.fields()) {
+    if ((info.flags & kFieldOutput) == 0 || info.type != FieldType::f64) continue;
+    switch (info.kind) {
+      case FieldKind::vector: {
+        const VectorView<Dim> v(particles.view(particles.template find<double, Dim>(info.name)));
+        fields_.push_back({info.name, 3, [v](Index i, int c) { return c < Dim ? v(i, c) : 0.0; }});
+        for (int d = 0; d < Dim; ++d) {
+          scalars_.push_back({info.component_names[static_cast<std::size_t>(d)], [v, d](Index i) { return v(i, d); }});
+        }
+        break;
+      }
+      case FieldKind::stress: {
+        const StressView<Dim> s(particles.view(particles.template find<double, kStressComponents<Dim>>(info.name)));
+        stress = s;
+        for (int k = 0; k < kStressComponents<Dim>; ++k) {
+          scalar(info.component_names[static_cast<std::size_t>(k)], [s, k](Index i) { return s[i][k]; });
+        }
+        scalar("p", [s](Index i) { return s.invariants(i).p; });
+        scalar("q", [s](Index i) { return s.invariants(i).q; });
+        break;
+      }
+      case FieldKind::history: {
+        const HistoryLayout& layout = sim.history_layout();
+        const auto values = particles.view(particles.template find<double, 0>(info.name));
+        for (std::size_t k = 0; k < layout.names().size(); ++k) {
+          const HistoryView h(values, layout, particles.material, static_cast<int>(k));
+          scalar(layout.names()[k], [h](Index i) { return h(i); });
+        }
+        break;
+      }
+      case FieldKind::scalar: {
+        const auto values = particles.view(particles.template find<double, 0>(info.name));
+        for (int c = 0; c < info.components; ++c) {
+          const std::string name = c < static_cast<int>(info.component_names.size())
+                                       ? info.component_names[static_cast<std::size_t>(c)]
+                                       : (info.components == 1 ? info.name : fmt::format("{}_{}", info.name, c));
+          scalar(name, [values, c](Index i) { return values(i, c); });
+        }
+        // V3: with the pore pressure, the total stresses sigma' - p_w 1 (the stress fields are
+        // effective stresses).
+        if (info.name == "pore_pressure" && stress) {
+          const StressView<Dim> s = *stress;
+          for (std::size_t c = 0; c < 6; ++c) {
+            const auto comp = static_cast<StressComponent>(c);
+            if (stress_slot<Dim>(comp) < 0) continue;
+            const bool normal = c < 3;
+            scalar(fmt::format("total_s{}", kStressComponentNames[c]), [s, comp, values, normal](Index i) {
+              return s(i, comp) - (normal ? values(i, 0) : 0.0);
+            });
+          }
+        }
+        break;
+      }
     }
   }
   const std::vector<int>* material = &particles.material;

@@ -1,8 +1,10 @@
 #pragma once
-// The one catalogue of output fields of a particle set (docs/output.md): the VTU frames, the
-// probes and the validation snapshots all read the state through it. Each entry has a name,
-// 1 or 3 components (vectors padded to 3 for ParaView) and a reader of its value at a
-// particle; scalars() adds the single components of vectors ("vx", "uy") for the probes.
+// The one catalogue of output fields of a particle set (docs/output.md): the VTU frames and the
+// probes read the state through it. It is made from the set's field declarations: every field
+// registered with kFieldOutput appears by its kind (a vector as a 3-vector and its components,
+// a stress as its components and p, q, history variables by name), plus the derived total
+// stresses where a pore pressure exists, and the material. Each entry has a name, 1 or 3
+// components and a reader of its value at a particle.
 #include <functional>
 #include <optional>
 #include <string>

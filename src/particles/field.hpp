@@ -39,12 +39,23 @@ constexpr FieldType field_type_of() {
   }
 }
 
+/// What the values of a field are, for output: the field catalogue (io/field_catalogue.hpp)
+/// writes a field by its kind, so that registering a field with kFieldOutput is all it takes
+/// to have it in the frames and the probes.
+enum class FieldKind {
+  scalar,   // one value per component, each written by its component name
+  vector,   // Dim components, written as a 3-vector named by the field (probes: the components)
+  stress,   // the per-dimension stress layout: its components, and the invariants p and q
+  history,  // material history variables: a component is a name of the HistoryLayout
+};
+
 struct FieldInfo {
   std::string name;
   FieldType type = FieldType::f64;
   int components = 1;
   std::vector<std::string> component_names;  // e.g. {"vx", "vy"}; empty for a scalar
   unsigned flags = 0;
+  FieldKind kind = FieldKind::scalar;
 };
 
 /// Typed handle of a field of N values of T per particle. N = 0: the component count is fixed

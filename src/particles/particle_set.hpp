@@ -56,12 +56,13 @@ class ParticleSet {
   /// Register a field (zero-initialised). N = 0 takes the component count from `components`.
   template <class T, int N>
   Field<T, N> add_field(std::string field_name, std::vector<std::string> component_names, unsigned flags,
-                        int components = N) {
+                        int components = N, FieldKind kind = FieldKind::scalar) {
     if (find_id(field_name) >= 0) {
       throw SolverError(fmt::format("{}: the field '{}' is registered twice", name_, field_name));
     }
     Column c;
-    c.info = {std::move(field_name), field_type_of<T>(), N > 0 ? N : components, std::move(component_names), flags};
+    c.info = {std::move(field_name), field_type_of<T>(), N > 0 ? N : components, std::move(component_names), flags,
+              kind};
     c.resize(position.size());
     columns_.push_back(std::move(c));
     return Field<T, N>{static_cast<int>(columns_.size()) - 1};

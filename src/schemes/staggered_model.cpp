@@ -87,21 +87,21 @@ StaggeredModel<Dim>::StaggeredModel(CaseSetup<Dim> case_setup, exec::Threads thr
     to_nodes = build_corrected_operator<Dim>(relation, nodes.position, stress_points, kernel);
   }
 
-  // Fields.
+  // Fields (the order is the order of the output frames).
   const int history = materials.history.stride();
-  fields.velocity =
-      nodes.template add_field<double, Dim>("velocity", axis_names("v", Dim), kFieldOutput | kFieldEvolving);
-  fields.stress = nodes.template add_field<double, NS>("stress", stress_names<Dim>(), kFieldOutput | kFieldEvolving);
+  const unsigned state = kFieldOutput | kFieldEvolving;
+  fields.velocity = nodes.template add_field<double, Dim>("velocity", axis_names("v", Dim), state, Dim, FieldKind::vector);
   fields.displacement =
-      nodes.template add_field<double, Dim>("displacement", axis_names("u", Dim), kFieldOutput | kFieldEvolving);
-  fields.history =
-      nodes.template add_field<double, 0>("history", materials.history.names(), kFieldOutput | kFieldEvolving, history);
+      nodes.template add_field<double, Dim>("displacement", axis_names("u", Dim), state, Dim, FieldKind::vector);
+  fields.stress = nodes.template add_field<double, NS>("stress", stress_names<Dim>(), state, NS, FieldKind::stress);
+  fields.history = nodes.template add_field<double, 0>("history", materials.history.names(), state, history,
+                                                       FieldKind::history);
   fields.sp_velocity =
-      stress_points.template add_field<double, Dim>("velocity", axis_names("v", Dim), kFieldOutput | kFieldEvolving);
+      stress_points.template add_field<double, Dim>("velocity", axis_names("v", Dim), state, Dim, FieldKind::vector);
   fields.sp_stress =
-      stress_points.template add_field<double, NS>("stress", stress_names<Dim>(), kFieldOutput | kFieldEvolving);
-  fields.sp_history = stress_points.template add_field<double, 0>("history", materials.history.names(),
-                                                                  kFieldOutput | kFieldEvolving, history);
+      stress_points.template add_field<double, NS>("stress", stress_names<Dim>(), state, NS, FieldKind::stress);
+  fields.sp_history = stress_points.template add_field<double, 0>("history", materials.history.names(), state,
+                                                                  history, FieldKind::history);
 
   node_sources = make_source_runs(nodes, materials);
   stress_point_sources = make_source_runs(stress_points, materials);
