@@ -1,6 +1,7 @@
 // rktsph: Runge–Kutta Taylor SPH for the dynamics of dry and saturated soils.
 #include <omp.h>
 
+#include <filesystem>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -39,6 +40,15 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   run_cmd->add_flag("--quiet,-q", run.quiet, "No progress output");
 
+  RunOptions resume;
+  auto* resume_cmd = app.add_subcommand(
+      "resume", "Continue an interrupted run from its checkpoint (output folder of `rktsph run`)");
+  resume_cmd->add_option("folder", resume.out_dir, "Output folder of the interrupted run")->required();
+  resume_cmd->add_option("--set,-s", resume.overrides, "Override time.end or an output.* key, e.g. --set time.end=20");
+  resume_cmd->add_option("--threads,-j", resume.threads, "Number of threads (default: all cores)")
+      ->check(CLI::NonNegativeNumber);
+  resume_cmd->add_flag("--quiet,-q", resume.quiet, "No progress output");
+
   std::string mp_file, mp_out;
   std::vector<std::string> mp_overrides;
   auto* mp_cmd =
@@ -70,6 +80,7 @@ int main(int argc, char** argv) {
 
   try {
     if (run_cmd->parsed()) return run_case(run);
+    if (resume_cmd->parsed()) return resume_case(resume);
     if (mp_cmd->parsed()) return run_material_point(mp_file, mp_out, mp_overrides);
     if (val_cmd->parsed()) {
       if (run.threads > 0) omp_set_num_threads(run.threads);
@@ -83,10 +94,17 @@ int main(int argc, char** argv) {
     }
   } catch (const InputError& e) {
     std::cerr << "error: " << e.what() << "\n";
-    return 2;
+    return kExitInput;
   } catch (const SolverError& e) {
     std::cerr << "error: " << e.what() << "\n";
-    return 3;
+    return kExitUnstable;
+  } catch (const IoError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return kExitIo;
+  } catch (const std::filesystem::filesystem_error& e) {
+    // A folder that cannot be made or read: the output path given is the problem.
+    std::cerr << "error: " << e.what() << "\n";
+    return kExitInput;
   } catch (const std::exception& e) {
     std::cerr << "error: " << e.what() << "\n";
     return 1;

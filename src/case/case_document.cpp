@@ -81,17 +81,22 @@ void apply_override(toml::table& root, const std::string& assignment) {
 }  // namespace
 
 CaseDocument load_case_document(const std::string& file, const std::vector<std::string>& overrides) {
-  CaseDocument doc;
-  doc.file = file;
-  doc.file_label = std::make_shared<const std::string>(file);
   std::ifstream in(file);
   if (!in) throw InputError(fmt::format("{}: cannot open the case file", file));
   std::stringstream buffer;
   buffer << in.rdbuf();
+  return parse_case_document(buffer.str(), file, overrides);
+}
+
+CaseDocument parse_case_document(const std::string& text, const std::string& label,
+                                 const std::vector<std::string>& overrides) {
+  CaseDocument doc;
+  doc.file = label;
+  doc.file_label = std::make_shared<const std::string>(label);
   try {
-    doc.table = toml::parse(buffer.str(), file);
+    doc.table = toml::parse(text, label);
   } catch (const toml::parse_error& e) {
-    throw InputError(fmt::format("{}, line {}: not valid TOML: {}", file, e.source().begin.line, e.description()));
+    throw InputError(fmt::format("{}, line {}: not valid TOML: {}", label, e.source().begin.line, e.description()));
   }
   for (const auto& o : overrides) apply_override(doc.table, o);
   return doc;

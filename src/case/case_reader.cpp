@@ -412,6 +412,8 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
       o->number("times", 0.0);
     }
     c.output_elements = o->boolean("elements", true);
+    if (o->has("checkpoint_interval")) c.checkpoint_interval = o->non_negative("checkpoint_interval", 0.0);
+    else o->number("checkpoint_interval", 0.0);
     c.probe_every = static_cast<int>(o->integer("probe_every", 1));
     o->require(c.probe_every >= 1, "probe_every", "must be >= 1");
     o->finish();

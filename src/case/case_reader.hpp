@@ -23,6 +23,9 @@ struct CaseDocument {
 };
 
 CaseDocument load_case_document(const std::string& file, const std::vector<std::string>& overrides);
+/// The same from the text of a case (a checkpoint's copy of it); `label` names it in errors.
+CaseDocument parse_case_document(const std::string& text, const std::string& label,
+                                 const std::vector<std::string>& overrides);
 /// The dimension of space of a case (geometry.dimension), checked.
 int case_dimension(const CaseDocument& doc);
 

@@ -163,6 +163,9 @@ struct CaseSetup {
 
   // output
   double output_interval = 0.0;      // s; 0 = first and last state only
+  /// s of simulated time between checkpoints; empty = a tenth of the run; 0 = none but the one
+  /// written when the run is interrupted (docs/output.md, "Interrupted runs").
+  std::optional<double> checkpoint_interval;
   std::vector<double> output_times;  // s; extra snapshots
   bool output_elements = true;
   int probe_every = 1;

@@ -2,11 +2,12 @@
 
 #include <cstdint>
 #include <cstring>
-#include <fstream>
+#include <sstream>
 
 #include <fmt/format.h>
 
 #include "core/error.hpp"
+#include "io/output_files.hpp"
 
 namespace rktsph::io {
 
@@ -49,8 +50,7 @@ std::string encode_block(const std::vector<T>& values) {
 
 void write_vtu(const std::string& path, const std::vector<double>& points, const std::vector<PointField>& fields) {
   const std::size_t n = points.size() / 3;
-  std::ofstream out(path, std::ios::binary);
-  if (!out) throw SolverError(fmt::format("cannot write output file {}", path));
+  std::ostringstream out(std::ios::binary);
   out << "<?xml version=\"1.0\"?>\n"
          "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
          "header_type=\"UInt32\">\n<UnstructuredGrid>\n";
@@ -78,18 +78,26 @@ void write_vtu(const std::string& path, const std::vector<double>& points, const
       << encode_block(offsets) << "\n</DataArray>\n";
   out << "<DataArray type=\"UInt8\" Name=\"types\" format=\"binary\">\n" << encode_block(types) << "\n</DataArray>\n";
   out << "</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
-  if (!out) throw SolverError(fmt::format("failed writing output file {}", path));
+  write_file_atomically(path, out.str(), false);
 }
 
 void PvdCollection::add(double time, const std::string& relative_file) {
   entries_.emplace_back(time, relative_file);
-  std::ofstream out(path_);
-  if (!out) throw SolverError(fmt::format("cannot write output file {}", path_));
-  out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n";
+  write();
+}
+
+void PvdCollection::restore(std::vector<Entry> entries) {
+  entries_ = std::move(entries);
+  write();
+}
+
+void PvdCollection::write() const {
+  std::string out = "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n";
   for (const auto& [t, file] : entries_) {
-    out << fmt::format("<DataSet timestep=\"{:.10g}\" part=\"0\" file=\"{}\"/>\n", t, file);
+    out += fmt::format("<DataSet timestep=\"{:.10g}\" part=\"0\" file=\"{}\"/>\n", t, file);
   }
-  out << "</Collection>\n</VTKFile>\n";
+  out += "</Collection>\n</VTKFile>\n";
+  write_file_atomically(path_, out, false);
 }
 
 }  // namespace rktsph::io

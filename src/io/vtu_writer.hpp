@@ -18,12 +18,17 @@ void write_vtu(const std::string& path, const std::vector<double>& points, const
 /// A ParaView collection (.pvd): one entry per output time.
 class PvdCollection {
  public:
+  using Entry = std::pair<double, std::string>;
   explicit PvdCollection(std::string path) : path_(std::move(path)) {}
-  /// Record a file (relative to the .pvd's folder) and rewrite the collection, so that a
-  /// run that stops early still leaves a readable collection.
+  /// Record a file (relative to the .pvd's folder) and replace the collection atomically, so
+  /// that a run that stops at any moment leaves a readable collection.
   void add(double time, const std::string& relative_file);
+  const std::vector<Entry>& entries() const { return entries_; }
+  /// Restart from the entries of a checkpoint (resume), rewriting the file.
+  void restore(std::vector<Entry> entries);
 
  private:
+  void write() const;
   std::string path_;
   std::vector<std::pair<double, std::string>> entries_;
 };

@@ -135,6 +135,21 @@ PorePressureSolver::PorePressureSolver(const Sparse& full, const Sparse& symmetr
   }
 }
 
+PorePressureSolver::WarmStart PorePressureSolver::warm_start() const {
+  WarmStart w;
+  w.previous.assign(impl_->previous.data(), impl_->previous.data() + impl_->previous.size());
+  w.valid = impl_->has_previous;
+  return w;
+}
+
+void PorePressureSolver::set_warm_start(const WarmStart& w) {
+  if (w.valid && w.previous.size() != free_.size()) {
+    throw InputError("the checkpoint's pressure warm start does not match this case's unknowns");
+  }
+  impl_->previous = Eigen::Map<const Eigen::VectorXd>(w.previous.data(), static_cast<Eigen::Index>(w.previous.size()));
+  impl_->has_previous = w.valid;
+}
+
 void PorePressureSolver::solve(std::span<const double> source, std::span<const double> p_old, std::span<double> p) {
   const auto t0 = std::chrono::steady_clock::now();
   const auto nf = static_cast<Eigen::Index>(free_.size());

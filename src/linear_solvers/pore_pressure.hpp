@@ -71,6 +71,15 @@ class PorePressureSolver {
   void solve(std::span<const double> source, std::span<const double> p_old, std::span<double> p);
 
   const PressureSolveStats& stats() const { return stats_; }
+  void set_stats(const PressureSolveStats& s) { stats_ = s; }
+  /// The previous solve's p^n on the free unknowns, from which the next starting guess is
+  /// extrapolated (checkpoints save and restore it: the guess fixes the iterates).
+  struct WarmStart {
+    std::vector<double> previous;
+    bool valid = false;
+  };
+  WarmStart warm_start() const;
+  void set_warm_start(const WarmStart& w);
   Index unknowns() const { return static_cast<Index>(free_.size()); }
   /// K restricted to the free (non-drained) nodes (tests: symmetry, definiteness).
   const Sparse& matrix() const;

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <numeric>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -91,6 +92,19 @@ class ParticleSet {
   FieldView<const T, N> view(Field<T, N> f) const {
     const Column& c = column(f.id);
     return FieldView<const T, N>(const_cast<Column&>(c).template data<T>(), size(), c.info.components);
+  }
+
+  /// Every value of field `id` (type-checked): the generic access of checkpoints and halos.
+  template <class T>
+  std::span<T> values(int id) {
+    Column& c = column(id);
+    if (c.info.type != field_type_of<T>()) throw SolverError(fmt::format("{}: field '{}' has another type", name_, c.info.name));
+    const auto n = static_cast<std::size_t>(size()) * static_cast<std::size_t>(c.info.components);
+    return {c.template data<T>(), n};
+  }
+  template <class T>
+  std::span<const T> values(int id) const {
+    return const_cast<ParticleSet*>(this)->template values<T>(id);
   }
 
   /// The declarations, in registration order (output writes them in this order).

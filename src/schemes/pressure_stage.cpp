@@ -6,6 +6,8 @@
 
 #include <fmt/format.h>
 
+#include "core/error.hpp"
+#include "io/state_archive.hpp"
 #include "operators/laplacian.hpp"
 
 namespace rktsph {
@@ -109,6 +111,35 @@ std::string PorePressureStage<Dim>::instability_hint() const {
       " (V3: impermeable faces carrying a total stress are unstable above C c_u/c_d = {}; "
       "here it is {:.2f}: time.cfl <= {:.3f})",
       kUndrainedCourantLimit, undrained_courant_, m_.time_step.courant * kUndrainedCourantLimit / undrained_courant_);
+}
+
+template <int Dim>
+void PorePressureStage<Dim>::save(io::StateArchive& a, const std::string& prefix) const {
+  const PorePressureSolver::WarmStart w = solver_->warm_start();
+  a.put(prefix + "warm_start", w.previous);
+  a.put_integer(prefix + "warm_start_valid", w.valid ? 1 : 0);
+  const PressureSolveStats& s = solver_->stats();
+  a.put(prefix + "stats", std::vector<double>{static_cast<double>(s.solves), static_cast<double>(s.total_iterations),
+                                              static_cast<double>(s.max_iterations), static_cast<double>(s.last_iterations),
+                                              s.last_error, s.max_error, s.seconds});
+  a.put(prefix + "seconds", seconds_);
+}
+
+template <int Dim>
+void PorePressureStage<Dim>::load(const io::StateArchive& a, const std::string& prefix) {
+  solver_->set_warm_start({a.doubles(prefix + "warm_start"), a.integer(prefix + "warm_start_valid") != 0});
+  const auto& v = a.doubles(prefix + "stats");
+  if (v.size() != 7) throw InputError("the checkpoint's pressure statistics are damaged");
+  PressureSolveStats s;
+  s.solves = static_cast<long>(v[0]);
+  s.total_iterations = static_cast<long>(v[1]);
+  s.max_iterations = static_cast<long>(v[2]);
+  s.last_iterations = static_cast<int>(v[3]);
+  s.last_error = v[4];
+  s.max_error = v[5];
+  s.seconds = v[6];
+  solver_->set_stats(s);
+  seconds_ = a.number(prefix + "seconds");
 }
 
 template <int Dim>

@@ -24,6 +24,10 @@ class PorePressureStage final : public Stage {
   std::string_view name() const override { return "pore_pressure"; }
   void run(const StepContext& context) override;
   std::size_t scratch_bytes() const override;
+  /// The PCG's warm start (p^{n-1}) and its statistics: a resumed run takes the same
+  /// iterations to the same pressures.
+  void save(io::StateArchive& archive, const std::string& prefix) const override;
+  void load(const io::StateArchive& archive, const std::string& prefix) override;
 
   Field<double, 1> pore_pressure() const { return pressure_; }
   /// The stress points' pressure-free half-step velocity (solver.pressure_divergence =

@@ -9,6 +9,7 @@
 #include <string_view>
 
 #include "case/case_setup.hpp"
+#include "io/state_archive.hpp"
 #include "materials/history_layout.hpp"
 #include "schemes/scheme.hpp"
 #include "schemes/staggered_model.hpp"
@@ -93,6 +94,13 @@ class Simulation {
   Index operator_patterns() const { return model_->to_stress_points.patterns() + model_->to_nodes.patterns(); }
   Index degenerate_operator_rows() const { return model_->degenerate_operator_rows(); }
   long max_source_substeps() const;
+
+  /// Checkpoints: the whole state a run carries from step to step (every evolving field of
+  /// both particle sets, the clock, the stages' own state), and its restoration into a
+  /// simulation built from the same case. load_state refuses (InputError) a state whose
+  /// particles, scheme or time step differ from this simulation's.
+  void save_state(io::StateArchive& archive) const;
+  void load_state(const io::StateArchive& archive);
 
  private:
   StepSums<Dim> balance_sums();

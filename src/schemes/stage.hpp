@@ -3,9 +3,13 @@
 // (docs/architecture.md, "Schemes and stages"). A scheme is an ordered list of stages
 // (schemes/scheme.hpp); the stages of V1 are reused by V3 and by any scheme registered later.
 #include <cstddef>
+#include <string>
 #include <string_view>
 
 namespace rktsph {
+namespace io {
+class StateArchive;
+}
 
 /// What every stage of a step t^n -> t^{n+1} is told.
 struct StepContext {
@@ -26,6 +30,11 @@ class Stage {
   virtual void run(const StepContext& context) = 0;
   /// Bytes of work space the stage holds (counted with the state).
   virtual std::size_t scratch_bytes() const { return 0; }
+  /// State the stage carries from one step to the next beyond the particle fields (a solver's
+  /// warm start, statistics), saved in checkpoints under `prefix` and restored on resume so
+  /// that the run continues bit for bit. Most stages have none.
+  virtual void save(io::StateArchive& /*archive*/, const std::string& /*prefix*/) const {}
+  virtual void load(const io::StateArchive& /*archive*/, const std::string& /*prefix*/) {}
 };
 
 }  // namespace rktsph

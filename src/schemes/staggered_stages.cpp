@@ -4,6 +4,7 @@
 #include <cmath>
 #include <utility>
 
+#include "io/state_archive.hpp"
 #include "operators/run_sums.hpp"
 
 namespace rktsph {
@@ -280,6 +281,16 @@ void NodeFullStep<Dim>::run(const StepContext& c) {
       },
       exec::Schedule::even, nodes.size());
   if (sources) src.integrate(dt, m_.node_sources, node_s, m_.nodes.view(m_.fields.history));
+}
+
+template <int Dim>
+void NodeFullStep<Dim>::save(io::StateArchive& a, const std::string& prefix) const {
+  a.put_integer(prefix + "max_source_substeps", sources_->max_substeps());
+}
+
+template <int Dim>
+void NodeFullStep<Dim>::load(const io::StateArchive& a, const std::string& prefix) {
+  sources_->set_max_substeps(static_cast<long>(a.integer(prefix + "max_source_substeps")));
 }
 
 // ---- velocity filter

@@ -34,6 +34,7 @@ class ViscoplasticSources {
   void integrate(double tau, const SourceRuns& runs, FieldView<double, NS> stress, FieldView<double, 0> history);
   /// The largest number of RK4 sub-steps one particle needed in one interval so far.
   long max_substeps() const { return max_substeps_; }
+  void set_max_substeps(long n) { max_substeps_ = n; }
   std::size_t bytes() const { return (sigma_start_.size() + rate_.size()) * sizeof(double); }
 
  private:
@@ -85,6 +86,8 @@ class NodeFullStep final : public Stage {
   void run(const StepContext& context) override;
   const ViscoplasticSources<Dim>& sources() const { return *sources_; }
   std::size_t scratch_bytes() const override { return sources_->bytes(); }
+  void save(io::StateArchive& archive, const std::string& prefix) const override;
+  void load(const io::StateArchive& archive, const std::string& prefix) override;
 
  private:
   StaggeredModel<Dim>& m_;

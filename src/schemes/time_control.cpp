@@ -59,6 +59,42 @@ void TimeControl<Dim>::end_step(const StepSums<Dim>& sums, double boundary_power
   ++steps_;
 }
 
+template <int Dim>
+void TimeControl<Dim>::save(io::StateArchive& a) const {
+  a.put("clock/time", time_);
+  a.put_integer("clock/steps", steps_);
+  a.put("clock/dt", step_.dt);
+  a.put("clock/external_work", external_work_);
+  a.put("clock/damping_loss", damping_loss_);
+  a.put("clock/initial_strain", initial_strain_);
+  a.put("clock/last_power", last_power_);
+  a.put("clock/last_damping_power", last_damping_power_);
+  a.put("clock/initial_energy", initial_energy_);
+  a.put("clock/kinetic_peak", kinetic_peak_);
+  a.put("clock/damping_off_time", damping_off_time_);
+  a.put("clock/kinetic_below_since", kinetic_below_since_);
+}
+
+template <int Dim>
+void TimeControl<Dim>::load(const io::StateArchive& a) {
+  if (a.number("clock/dt") != step_.dt) {
+    throw InputError(fmt::format("the checkpoint's time step ({:.17g} s) is not this case's ({:.17g} s): the case "
+                                 "changed since it was written",
+                                 a.number("clock/dt"), step_.dt));
+  }
+  time_ = a.number("clock/time");
+  steps_ = static_cast<long>(a.integer("clock/steps"));
+  external_work_ = a.number("clock/external_work");
+  damping_loss_ = a.number("clock/damping_loss");
+  initial_strain_ = a.number("clock/initial_strain");
+  last_power_ = a.number("clock/last_power");
+  last_damping_power_ = a.number("clock/last_damping_power");
+  initial_energy_ = a.number("clock/initial_energy");
+  kinetic_peak_ = a.number("clock/kinetic_peak");
+  damping_off_time_ = a.number("clock/damping_off_time");
+  kinetic_below_since_ = a.number("clock/kinetic_below_since");
+}
+
 template class TimeControl<1>;
 template class TimeControl<2>;
 template class TimeControl<3>;

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "case/case_setup.hpp"
+#include "io/state_archive.hpp"
 #include "schemes/time_step.hpp"
 
 namespace rktsph {
@@ -57,6 +58,10 @@ class TimeControl {
   /// After the stages of a step: account the energies, update the damping switch, check the
   /// growth guard (throws SolverError with `hint` appended) and advance the clock.
   void end_step(const StepSums<Dim>& sums, double boundary_power, const std::string& hint);
+
+  /// Checkpoints: every value the clock carries (the step length is the case's).
+  void save(io::StateArchive& archive) const;
+  void load(const io::StateArchive& archive);
 
   /// The kinetic energy of a stable run cannot exceed this multiple of the work done on the
   /// body plus its initial energy (the materials only dissipate).

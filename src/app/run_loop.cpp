@@ -1,0 +1,483 @@
+#include "app/run_loop.hpp"
+
+#include <omp.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <iostream>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <nlohmann/json.hpp>
+
+#include "app/signals.hpp"
+#include "core/error.hpp"
+#include "io/checkpoint.hpp"
+#include "io/field_catalogue.hpp"
+#include "io/output_files.hpp"
+#include "io/vtu_writer.hpp"
+#include "rktsph/version.hpp"
+#include "schemes/pressure_stage.hpp"
+#include "schemes/simulation.hpp"
+
+namespace rktsph {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+template <int Dim>
+std::vector<double> padded_points(const std::vector<Vec<Dim>>& x) {
+  std::vector<double> pts(x.size() * 3, 0.0);
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    for (int d = 0; d < Dim; ++d) pts[i * 3 + static_cast<std::size_t>(d)] = x[i][d];
+  }
+  return pts;
+}
+
+std::string duration_text(double seconds) {
+  if (!std::isfinite(seconds) || seconds < 0) return "?";
+  if (seconds < 90) return fmt::format("{:.0f} s", seconds);
+  if (seconds < 5400) return fmt::format("{:.1f} min", seconds / 60);
+  return fmt::format("{:.1f} h", seconds / 3600);
+}
+
+// The pvd entries as two archive values (times; names joined by newlines), and back.
+void save_entries(io::StateArchive& a, const std::string& key, const std::vector<io::PvdCollection::Entry>& e) {
+  std::vector<double> times;
+  std::string names;
+  for (const auto& [t, f] : e) {
+    times.push_back(t);
+    names += f + "\n";
+  }
+  a.put(key + "/times", times);
+  a.put_text(key + "/files", names);
+}
+
+std::vector<io::PvdCollection::Entry> load_entries(const io::StateArchive& a, const std::string& key) {
+  const auto& times = a.doubles(key + "/times");
+  std::istringstream names(a.text(key + "/files"));
+  std::vector<io::PvdCollection::Entry> out;
+  std::string line;
+  for (double t : times) {
+    if (!std::getline(names, line)) throw InputError("the checkpoint's list of frames is damaged");
+    out.emplace_back(t, line);
+  }
+  return out;
+}
+
+// Everything the loop needs to continue its output streams exactly.
+struct LoopState {
+  long frame = 0;
+  double next_output = 0.0;
+  long next_time_index = 0;
+  long energy_every = 1;
+  double next_checkpoint = 0.0;  // simulated time of the next periodic checkpoint
+  long checkpoints = 0;
+  double loop_seconds = 0.0;  // time-loop wall time of the earlier segments of the run
+  long resumed_from = -1;     // step a resumed run started from (-1: not resumed)
+};
+
+}  // namespace
+
+template <int Dim>
+int run_loop(const LoopInput& in) {
+  const RunOptions& opt = in.options;
+  const fs::path& out = in.out;
+  const bool resuming = in.checkpoint != nullptr;
+  const auto t_setup = Clock::now();
+  const CaseSetup<Dim> setup = read_case<Dim>(in.document);
+  Simulation<Dim> solver(setup);
+  if (resuming) solver.load_state(*in.checkpoint);
+  const double setup_seconds = std::chrono::duration<double>(Clock::now() - t_setup).count();
+  const io::FieldCatalogue<Dim> node_fields(solver, io::FieldCatalogue<Dim>::Set::nodes);
+  const io::FieldCatalogue<Dim> stress_point_fields(solver, io::FieldCatalogue<Dim>::Set::stress_points);
+  const PorePressureStage<Dim>* pressure = solver.scheme().template find<PorePressureStage<Dim>>();
+
+  // Probes: the nearest node; a probe outside the body is an input error.
+  struct Probe {
+    std::string name;
+    Index node;
+    std::vector<std::pair<std::string, io::ScalarField>> fields;
+  };
+  std::vector<Probe> probes;
+  const auto& nodes = solver.nodes();
+  for (const ProbeSpec& spec : setup.probes) {
+    Vec<Dim> x;
+    for (int d = 0; d < Dim; ++d) x[d] = spec.position[static_cast<std::size_t>(d)];
+    Index best = 0;
+    double best_d = std::numeric_limits<double>::infinity();
+    for (Index i = 0; i < nodes.size(); ++i) {
+      const double dist = (nodes.position[static_cast<std::size_t>(i)] - x).norm();
+      if (dist < best_d) {
+        best_d = dist;
+        best = i;
+      }
+    }
+    if (best_d > 0.5 * std::sqrt(static_cast<double>(Dim)) * setup.dx + 1e-9) {
+      throw InputError(fmt::format("{}: probe '{}' at [{}] lies outside the body (nearest node is {:.4g} m away)",
+                                   spec.where, spec.name, fmt::join(spec.position, ", "), best_d));
+    }
+    Probe p{spec.name, best, {}};
+    for (const auto& f : spec.fields) {
+      auto value = node_fields.scalar(f);
+      if (!value) {
+        throw InputError(fmt::format("{}, key 'probe.fields': unknown field '{}' for probe '{}' (available: {})",
+                                     spec.where, f, spec.name, fmt::join(node_fields.scalar_names(), ", ")));
+      }
+      p.fields.emplace_back(f, std::move(*value));
+    }
+    probes.push_back(std::move(p));
+  }
+
+  const double dt = solver.dt();
+  const long total_steps = static_cast<long>(std::ceil(setup.end_time / dt - 1e-9));
+  const double checkpoint_every = setup.checkpoint_interval.value_or(setup.end_time / 10.0);
+  LoopState loop;
+  if (resuming && solver.step_count() > total_steps) {
+    throw InputError(fmt::format("{}: the checkpoint is at t = {:.6g} s (step {}), past time.end = {:.6g} s", out.string(),
+                                 solver.time(), solver.step_count(), setup.end_time));
+  }
+  if (resuming && solver.step_count() == total_steps) {
+    if (!opt.quiet) {
+      std::cerr << fmt::format("{}: the run is complete (t = {:.6g} s); extend it with --set time.end=...\n",
+                               out.string(), solver.time());
+    }
+    return 0;
+  }
+  if (resuming) {
+    const io::StateArchive& a = *in.checkpoint;
+    loop.frame = static_cast<long>(a.integer("run/frame"));
+    loop.next_output = a.number("run/next_output");
+    loop.next_time_index = static_cast<long>(a.integer("run/next_time_index"));
+    loop.energy_every = static_cast<long>(a.integer("run/energy_every"));
+    loop.checkpoints = static_cast<long>(a.integer("run/checkpoints"));
+    loop.loop_seconds = a.number("run/loop_seconds");
+    loop.resumed_from = solver.step_count();
+    loop.next_checkpoint = a.number("run/next_checkpoint");
+    if (setup.checkpoint_interval && *setup.checkpoint_interval != a.number("run/checkpoint_interval")) {
+      loop.next_checkpoint = checkpoint_every > 0.0 ? solver.time() + checkpoint_every : HUGE_VAL;  // changed on resume
+    }
+    // Frames written after the checkpoint (up to the interruption) are replaced as the run goes.
+    for (const auto& entry : fs::directory_iterator(out / "vtu")) {
+      const std::string f = entry.path().filename().string();
+      long index = -1;
+      if (std::sscanf(f.c_str(), "nodes_%ld.vtu", &index) == 1 || std::sscanf(f.c_str(), "elements_%ld.vtu", &index) == 1) {
+        if (index >= loop.frame) fs::remove(entry.path());
+      }
+    }
+  } else {
+    loop.energy_every = std::max(1L, total_steps / 2000);
+    loop.next_output = setup.output_interval > 0 ? setup.output_interval : std::numeric_limits<double>::infinity();
+    while (loop.next_time_index < static_cast<long>(setup.output_times.size()) &&
+           setup.output_times[static_cast<std::size_t>(loop.next_time_index)] <= 0.0) {
+      ++loop.next_time_index;
+    }
+    loop.next_checkpoint = checkpoint_every > 0.0 ? checkpoint_every : HUGE_VAL;
+  }
+
+  // Output streams: a fresh run starts them; a resumed one cuts them back to the checkpoint.
+  io::RowFile probe_csv((out / "probes.csv").string(), resuming ? in.checkpoint->integer("run/probes_bytes") : -1);
+  io::RowFile energy_csv((out / "energy.csv").string(), resuming ? in.checkpoint->integer("run/energy_bytes") : -1);
+  io::PvdCollection node_pvd((out / "nodes.pvd").string());
+  io::PvdCollection elem_pvd((out / "elements.pvd").string());
+  if (resuming) {
+    node_pvd.restore(load_entries(*in.checkpoint, "run/node_frames"));
+    elem_pvd.restore(load_entries(*in.checkpoint, "run/stress_point_frames"));
+  } else {
+    std::string header = "t";
+    for (const auto& p : probes) {
+      for (const auto& [fname, ref] : p.fields) header += fmt::format(",{}.{}", p.name, fname);
+    }
+    probe_csv.append(header + "\n");
+    energy_csv.append("t,kinetic,strain,external_work,damping_loss,imbalance\n");
+  }
+  auto record_probes = [&] {
+    std::string row = fmt::format("{:.10g}", solver.time());
+    for (const auto& p : probes) {
+      for (const auto& [fname, value] : p.fields) row += fmt::format(",{:.10g}", value(p.node));
+    }
+    probe_csv.append(row + "\n");
+  };
+  auto record_energy = [&] {
+    const EnergyBalance e = solver.energy();
+    energy_csv.append(fmt::format("{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g}\n", solver.time(), e.kinetic,
+                                  e.strain - e.initial_strain, e.external_work, e.damping_loss, e.imbalance()));
+  };
+  const auto node_points = padded_points<Dim>(solver.nodes().position);
+  const auto elem_points = padded_points<Dim>(solver.stress_points().position);
+  auto write_frame = [&] {
+    const std::string name = fmt::format("nodes_{:06d}.vtu", loop.frame);
+    io::write_vtu((out / "vtu" / name).string(), node_points, node_fields.extract());
+    node_pvd.add(solver.time(), "vtu/" + name);
+    if (setup.output_elements) {
+      const std::string ename = fmt::format("elements_{:06d}.vtu", loop.frame);
+      io::write_vtu((out / "vtu" / ename).string(), elem_points, stress_point_fields.extract());
+      elem_pvd.add(solver.time(), "vtu/" + ename);
+    }
+    ++loop.frame;
+  };
+  auto flush_streams = [&] {
+    probe_csv.flush();
+    energy_csv.flush();
+  };
+  const fs::path checkpoint_file = out / "checkpoint" / "checkpoint.h5";
+  auto write_checkpoint = [&](double loop_seconds) {
+    flush_streams();
+    io::StateArchive a;
+    solver.save_state(a);
+    a.put_text("case/document", [&] {
+      std::ostringstream text;
+      text << in.document.table;
+      return text.str();
+    }());
+    a.put_text("case/file", opt.case_file);
+    a.put_integer("case/dimension", Dim);
+    a.put_integer("run/frame", loop.frame);
+    a.put("run/next_output", loop.next_output);
+    a.put_integer("run/next_time_index", loop.next_time_index);
+    a.put_integer("run/energy_every", loop.energy_every);
+    a.put_integer("run/checkpoints", loop.checkpoints + 1);
+    a.put("run/loop_seconds", loop_seconds);
+    a.put("run/next_checkpoint", loop.next_checkpoint);
+    a.put("run/checkpoint_interval", checkpoint_every);
+    a.put_integer("run/probes_bytes", probe_csv.written());
+    a.put_integer("run/energy_bytes", energy_csv.written());
+    save_entries(a, "run/node_frames", node_pvd.entries());
+    save_entries(a, "run/stress_point_frames", elem_pvd.entries());
+    fs::create_directories(out / "checkpoint");
+    io::write_checkpoint(checkpoint_file.string(), a);
+    ++loop.checkpoints;
+  };
+
+  // summary.json: written at the start (status "running") and replaced at the end.
+  const int threads = omp_get_max_threads();
+  auto summary = [&](const std::string& status, const std::string& message, double loop_seconds) {
+    const double nodes_count = static_cast<double>(solver.nodes().size());
+    const double segment_steps = static_cast<double>(solver.step_count() - std::max(0L, loop.resumed_from));
+    const double node_steps = nodes_count * segment_steps;
+    const double segment_seconds = loop_seconds - loop.loop_seconds;
+    const EnergyBalance e = solver.energy();
+    nlohmann::json j = {
+        {"case", opt.case_file},
+        {"title", setup.title},
+        {"status", status},
+        {"message", message},
+        {"version", kVersion},
+        {"git_revision", kGitRevision},
+        {"dimension", Dim},
+        {"scheme", solver.scheme().name()},
+        {"nodes", solver.nodes().size()},
+        {"stress_points", solver.stress_points().size()},
+        {"spacing", setup.dx},
+        {"smoothing_length", setup.h_over_dx * setup.dx},
+        {"max_wave_speed", solver.max_wave_speed()},
+        {"dt", dt},
+        {"cfl", solver.cfl()},
+        {"steps", solver.step_count()},
+        {"steps_planned", total_steps},
+        {"time", solver.time()},
+        {"threads", threads},
+        {"setup_seconds", setup_seconds},
+        {"wall_seconds", loop_seconds},
+        {"node_steps_per_second", segment_seconds > 0 ? node_steps / segment_seconds : 0.0},
+        {"node_steps_per_second_per_thread", segment_seconds > 0 ? node_steps / segment_seconds / threads : 0.0},
+        {"neighbour_pairs", solver.pairs()},
+        {"pairs_per_node", static_cast<double>(solver.pairs()) / nodes_count},
+        {"bytes_state", solver.state_bytes()},
+        {"bytes_operators", solver.operator_bytes()},
+        {"bytes_per_node", static_cast<double>(solver.state_bytes() + solver.operator_bytes()) / nodes_count},
+        {"max_source_substeps", solver.max_source_substeps()},
+        {"energy",
+         {{"kinetic", e.kinetic},
+          {"strain", e.strain - e.initial_strain},
+          {"external_work", e.external_work},
+          {"damping_loss", e.damping_loss},
+          {"imbalance", e.imbalance()}}},
+        {"output_frames", loop.frame},
+        {"checkpoints_written", loop.checkpoints},
+    };
+    j["checkpoint"] = loop.checkpoints > 0 ? nlohmann::json(checkpoint_file.string()) : nlohmann::json(nullptr);
+    j["resumed_from_step"] = loop.resumed_from >= 0 ? nlohmann::json(loop.resumed_from) : nlohmann::json(nullptr);
+    j["damping_off_time"] = std::isfinite(solver.clock().damping_off_time())
+                                ? nlohmann::json(solver.clock().damping_off_time())
+                                : nlohmann::json(nullptr);
+    j["peak_kinetic_energy"] = solver.clock().peak_kinetic_energy();
+    if (pressure != nullptr) {
+      // V3: the pore-pressure solve (method-notes §2.4): PCG iterations, residual, time share.
+      const PressureSolveStats& ps = pressure->stats();
+      j["pressure_solve"] = {
+          {"preconditioner", setup.fluid.incomplete_cholesky ? "incomplete_cholesky" : "jacobi"},
+          {"tolerance", setup.fluid.tolerance},
+          {"unknowns", pressure->solver().unknowns()},
+          {"solves", ps.solves},
+          {"iterations_max", ps.max_iterations},
+          {"iterations_mean", ps.mean_iterations()},
+          {"final_residual", ps.last_error},
+          {"max_residual", ps.max_error},
+          {"solve_seconds", ps.seconds},
+          {"pressure_step_seconds", pressure->seconds()},
+          {"share_of_loop_time", loop_seconds > 0 ? pressure->seconds() / loop_seconds : 0.0},
+      };
+    }
+    io::write_file_atomically((out / "summary.json").string(), j.dump(2) + "\n");
+  };
+
+  const bool progress = !opt.quiet && isatty(fileno(stderr)) != 0;
+  if (!opt.quiet) {
+    if (resuming) {
+      std::cerr << fmt::format("rktsph {}: resuming {} at step {} of {} (t = {:.6g} s), {} thread{}\n", kVersion,
+                               out.string(), solver.step_count(), total_steps, solver.time(), threads,
+                               threads > 1 ? "s" : "");
+    } else {
+      std::cerr << fmt::format(
+          "rktsph {}: {} ({}D, {} nodes, {} stress points, dt = {:.4g} s, C = {:.3f}, {} steps, {} thread{})\n",
+          kVersion, opt.case_file, Dim, solver.nodes().size(), solver.stress_points().size(), dt, solver.cfl(),
+          total_steps, threads, threads > 1 ? "s" : "");
+    }
+    if (pressure != nullptr && pressure->impermeable_stress_face_nodes() > 0 &&
+        pressure->undrained_courant() > PorePressureStage<Dim>::kUndrainedCourantLimit) {
+      std::cerr << fmt::format(
+          "warning: {} boundary nodes are on impermeable faces that carry a total stress (or are free), and the "
+          "undrained Courant number C c_u/c_d = {:.2f} exceeds {}, above which such faces have been measured "
+          "unstable; time.cfl <= {:.3f} keeps it below (docs/VALIDATION.md, Case 16)\n",
+          pressure->impermeable_stress_face_nodes(), pressure->undrained_courant(),
+          PorePressureStage<Dim>::kUndrainedCourantLimit,
+          solver.cfl() * PorePressureStage<Dim>::kUndrainedCourantLimit / pressure->undrained_courant());
+    }
+    if (solver.degenerate_operator_rows() > 0) {
+      std::cerr << fmt::format("warning: {} particles have too few neighbours for the corrected operator and use "
+                               "plain SPH sums\n",
+                               solver.degenerate_operator_rows());
+    }
+  }
+
+  install_stop_handlers();
+  std::string status = "completed", message;
+  int exit_code = 0;
+  const auto t_loop = Clock::now();
+  auto loop_seconds = [&] { return loop.loop_seconds + std::chrono::duration<double>(Clock::now() - t_loop).count(); };
+  try {
+    summary("running", "", loop.loop_seconds);
+    if (!resuming) {
+      record_probes();
+      record_energy();
+      write_frame();
+      flush_streams();
+    }
+    auto last_progress = t_loop;
+    const long first = solver.step_count();
+    for (long n = first; n < total_steps; ++n) {
+      solver.step();
+      const bool last = n + 1 == total_steps;
+      if ((n + 1) % setup.probe_every == 0 || last) record_probes();
+      if ((n + 1) % loop.energy_every == 0 || last) record_energy();
+      bool output = last;
+      const double t = solver.time();
+      if (t >= loop.next_output - 1e-12 * setup.end_time) {
+        output = true;
+        while (loop.next_output <= t + 1e-12 * setup.end_time) loop.next_output += setup.output_interval;
+      }
+      // Snapshots requested at given times: the first step at or after each time.
+      while (loop.next_time_index < static_cast<long>(setup.output_times.size()) &&
+             t >= setup.output_times[static_cast<std::size_t>(loop.next_time_index)] - 1e-12) {
+        output = true;
+        ++loop.next_time_index;
+      }
+      if (output) {
+        write_frame();
+        flush_streams();  // the tables are on disk at every output step
+      }
+      if (t >= loop.next_checkpoint - 1e-12 * setup.end_time && !last) {
+        while (loop.next_checkpoint <= t + 1e-12 * setup.end_time) loop.next_checkpoint += checkpoint_every;
+        write_checkpoint(loop_seconds());
+      }
+      if (const int sig = stop_signal(); sig != 0 && !last) {
+        // Stopped by a signal: a checkpoint of this state, then a frame of it for the user (the
+        // checkpoint's list of frames ends before it: a resumed run rewrites it in turn).
+        write_checkpoint(loop_seconds());
+        if (!output) write_frame();
+        status = "interrupted";
+        message = fmt::format("stopped by signal {} ({}) after step {} at t = {:.6g} s; resume with: rktsph resume {}",
+                              sig, sig == SIGINT ? "SIGINT" : (sig == SIGTERM ? "SIGTERM" : "signal"),
+                              solver.step_count(), t, out.string());
+        exit_code = 128 + sig;
+        break;
+      }
+      if (progress) {
+        const auto now = Clock::now();
+        if (std::chrono::duration<double>(now - last_progress).count() > 0.5 || last) {
+          last_progress = now;
+          const double elapsed = std::chrono::duration<double>(now - t_loop).count();
+          const double eta = elapsed * static_cast<double>(total_steps - n - 1) / static_cast<double>(n + 1 - first);
+          std::cerr << fmt::format("\r  t = {:.5g} s of {:.5g} s ({:3.0f} %), step {} of {}, ETA {}   ", t,
+                                   setup.end_time, 100.0 * t / setup.end_time, n + 1, total_steps, duration_text(eta))
+                    << std::flush;
+        }
+      }
+    }
+    if (progress) std::cerr << "\n";
+    flush_streams();
+    // A checkpoint of the end state: the run can be extended (rktsph resume --set time.end=...).
+    if (exit_code == 0 && checkpoint_every > 0.0) write_checkpoint(loop_seconds());
+  } catch (const SolverError& e) {
+    if (progress) std::cerr << "\n";
+    status = "unstable";
+    message = e.what();
+    exit_code = kExitUnstable;
+  } catch (const IoError& e) {
+    if (progress) std::cerr << "\n";
+    status = "failed";
+    message = e.what();
+    exit_code = kExitIo;
+  }
+  if (exit_code == kExitUnstable) {
+    try {
+      flush_streams();  // the rows of the last good steps
+    } catch (const IoError& e) {
+      message += fmt::format("; {}", e.what());
+    }
+  }
+  const double seconds = loop_seconds();
+  try {
+    summary(status, message, seconds);
+  } catch (const IoError& e) {
+    // The disk is full or gone: say so, and keep the status of the run.
+    std::cerr << "error: " << e.what() << "\n";
+    if (exit_code == 0) exit_code = kExitIo;
+  }
+  if (!opt.quiet) {
+    if (pressure != nullptr) {
+      const PressureSolveStats& ps = pressure->stats();
+      std::cerr << fmt::format("pore pressure: {} PCG solves, iterations mean {:.1f} / max {}, final relative "
+                               "residual {:.2e}; pressure step {:.0f} % of the loop time\n",
+                               ps.solves, ps.mean_iterations(), ps.max_iterations, ps.last_error,
+                               seconds > 0 ? 100.0 * pressure->seconds() / seconds : 0.0);
+    }
+    const double node_steps = static_cast<double>(solver.nodes().size()) *
+                              static_cast<double>(solver.step_count() - std::max(0L, loop.resumed_from));
+    const double segment = seconds - loop.loop_seconds;
+    if (exit_code == 0) {
+      std::cerr << fmt::format("done: {} steps in {:.2f} s ({:.3g} node-steps/s); output in {}\n",
+                               solver.step_count() - std::max(0L, loop.resumed_from), segment,
+                               segment > 0 ? node_steps / segment : 0.0, out.string());
+    }
+  }
+  // A run that did not complete says why, --quiet or not.
+  if (status == "interrupted") {
+    std::cerr << fmt::format("{}\n", message);
+  } else if (exit_code != 0) {
+    std::cerr << fmt::format("error: {}\nthe output up to the last good step is kept in {}\n", message, out.string());
+  }
+  return exit_code;
+}
+
+template int run_loop<1>(const LoopInput&);
+template int run_loop<2>(const LoopInput&);
+
+}  // namespace rktsph

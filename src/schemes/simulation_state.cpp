@@ -1,0 +1,132 @@
+// Saving and restoring the state of a Simulation for checkpoints (io/checkpoint.hpp): what
+// Simulation::step carries from one step to the next, so that a resumed run continues bit for
+// bit as if it had not stopped.
+#include <cstring>
+
+#include <fmt/format.h>
+
+#include "core/error.hpp"
+#include "schemes/simulation.hpp"
+
+namespace rktsph {
+
+namespace {
+
+template <int Dim>
+void save_set(const ParticleSet<Dim>& set, io::StateArchive& a) {
+  const std::string p = set.name() + "/";
+  std::vector<double> x;
+  x.reserve(set.position.size() * Dim);
+  for (const auto& v : set.position) {
+    for (int d = 0; d < Dim; ++d) x.push_back(v[d]);
+  }
+  a.put(p + "position", std::move(x));
+  a.put(p + "volume", set.volume);
+  a.put(p + "density", set.density);
+  a.put(p + "material", std::vector<std::int64_t>(set.material.begin(), set.material.end()));
+  a.put(p + "global_id", set.global_id);
+  const auto infos = set.fields();
+  for (std::size_t id = 0; id < infos.size(); ++id) {
+    const FieldInfo& f = infos[id];
+    if ((f.flags & kFieldEvolving) == 0) continue;
+    const std::string key = p + "fields/" + f.name;
+    const int i = static_cast<int>(id);
+    switch (f.type) {
+      case FieldType::f64: {
+        const auto v = set.template values<double>(i);
+        a.put(key, std::vector<double>(v.begin(), v.end()));
+        break;
+      }
+      case FieldType::i64: {
+        const auto v = set.template values<std::int64_t>(i);
+        a.put(key, std::vector<std::int64_t>(v.begin(), v.end()));
+        break;
+      }
+      case FieldType::u8: {
+        const auto v = set.template values<std::uint8_t>(i);
+        a.put(key, std::vector<std::uint8_t>(v.begin(), v.end()));
+        break;
+      }
+    }
+  }
+}
+
+template <class T>
+void copy_into(std::span<T> to, const std::vector<T>& from, const std::string& key) {
+  if (from.size() != to.size()) {
+    throw InputError(fmt::format("the checkpoint's '{}' has {} values, this case {}: the case changed since it was written",
+                                 key, from.size(), to.size()));
+  }
+  std::copy(from.begin(), from.end(), to.begin());
+}
+
+template <int Dim>
+void load_set(ParticleSet<Dim>& set, const io::StateArchive& a) {
+  const std::string p = set.name() + "/";
+  // The particles are made again from the case; they must be the checkpoint's, bit for bit.
+  const auto& x = a.doubles(p + "position");
+  bool same = x.size() == set.position.size() * Dim && a.integers(p + "global_id") == set.global_id;
+  for (std::size_t i = 0; same && i < set.position.size(); ++i) {
+    for (int d = 0; d < Dim; ++d) same = same && x[i * Dim + static_cast<std::size_t>(d)] == set.position[i][d];
+  }
+  if (!same) {
+    throw InputError(fmt::format("the checkpoint's {} are not this case's ({} in the checkpoint, {} here): the case "
+                                 "changed since it was written",
+                                 set.name(), x.size() / Dim, set.position.size()));
+  }
+  copy_into(std::span<double>(set.volume), a.doubles(p + "volume"), p + "volume");
+  copy_into(std::span<double>(set.density), a.doubles(p + "density"), p + "density");
+  const auto infos = set.fields();
+  for (std::size_t id = 0; id < infos.size(); ++id) {
+    const FieldInfo& f = infos[id];
+    if ((f.flags & kFieldEvolving) == 0) continue;
+    const std::string key = p + "fields/" + f.name;
+    const int i = static_cast<int>(id);
+    switch (f.type) {
+      case FieldType::f64: copy_into(set.template values<double>(i), a.doubles(key), key); break;
+      case FieldType::i64: copy_into(set.template values<std::int64_t>(i), a.integers(key), key); break;
+      case FieldType::u8: copy_into(set.template values<std::uint8_t>(i), a.bytes(key), key); break;
+    }
+  }
+}
+
+std::string stage_prefix(std::size_t index, std::string_view name) { return fmt::format("stages/{:02d}_{}/", index, name); }
+
+}  // namespace
+
+template <int Dim>
+void Simulation<Dim>::save_state(io::StateArchive& a) const {
+  a.put_text("scheme/name", scheme_->name());
+  a.put_integer("scheme/dimension", Dim);
+  save_set(model_->nodes, a);
+  save_set(model_->stress_points, a);
+  clock_.save(a);
+  for (std::size_t k = 0; k < scheme_->stages().size(); ++k) {
+    const Stage& s = *scheme_->stages()[k];
+    s.save(a, stage_prefix(k, s.name()));
+  }
+}
+
+template <int Dim>
+void Simulation<Dim>::load_state(const io::StateArchive& a) {
+  if (a.text("scheme/name") != scheme_->name() || a.integer("scheme/dimension") != Dim) {
+    throw InputError(fmt::format("the checkpoint is of the {}D scheme '{}', this case runs the {}D scheme '{}'",
+                                 a.integer("scheme/dimension"), a.text("scheme/name"), Dim, scheme_->name()));
+  }
+  load_set(model_->nodes, a);
+  load_set(model_->stress_points, a);
+  clock_.load(a);
+  for (std::size_t k = 0; k < scheme_->stages().size(); ++k) {
+    Stage& s = *scheme_->stages()[k];
+    s.load(a, stage_prefix(k, s.name()));
+  }
+}
+
+template void Simulation<1>::save_state(io::StateArchive&) const;
+template void Simulation<2>::save_state(io::StateArchive&) const;
+template void Simulation<3>::save_state(io::StateArchive&) const;
+template void Simulation<1>::load_state(const io::StateArchive&);
+template void Simulation<2>::load_state(const io::StateArchive&);
+template void Simulation<3>::load_state(const io::StateArchive&);
+
+}  // namespace rktsph
