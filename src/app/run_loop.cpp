@@ -206,6 +206,13 @@ int run_loop(const LoopInput& in) {
   };
   auto record_energy = [&] {
     const EnergyBalance e = solver.energy();
+    // A stress can overflow while every velocity is still finite (the step's own check looks at
+    // the velocities): an infinite energy is an unstable run, never a completed one.
+    if (!std::isfinite(e.kinetic + e.strain + e.external_work + e.damping_loss)) {
+      throw SolverError(fmt::format("the energy became non-finite at t = {:.6g} s (step {}): the run is unstable; "
+                                    "reduce the time step (time.cfl = {:.3g}) or check the loads and material parameters",
+                                    solver.time(), solver.step_count(), solver.cfl()));
+    }
     energy_csv.append(fmt::format("{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g}\n", solver.time(), e.kinetic,
                                   e.strain - e.initial_strain, e.external_work, e.damping_loss, e.imbalance()));
   };
