@@ -216,15 +216,16 @@ int run_loop(const LoopInput& in) {
     energy_csv.append(fmt::format("{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g}\n", solver.time(), e.kinetic,
                                   e.strain - e.initial_strain, e.external_work, e.damping_loss, e.imbalance()));
   };
-  const auto node_points = padded_points<Dim>(solver.nodes().position);
-  const auto elem_points = padded_points<Dim>(solver.stress_points().position);
   auto write_frame = [&] {
+    // The current positions (they move in a large-deformation scheme).
+    const auto node_points = padded_points<Dim>(solver.nodes().position);
     const std::string name = fmt::format("nodes_{:06d}.vtu", loop.frame);
     io::write_vtu((out / "vtu" / name).string(), node_points, node_fields.extract());
     node_pvd.add(solver.time(), "vtu/" + name);
     if (setup.output_elements) {
       const std::string ename = fmt::format("elements_{:06d}.vtu", loop.frame);
-      io::write_vtu((out / "vtu" / ename).string(), elem_points, stress_point_fields.extract());
+      io::write_vtu((out / "vtu" / ename).string(), padded_points<Dim>(solver.stress_points().position),
+                    stress_point_fields.extract());
       elem_pvd.add(solver.time(), "vtu/" + ename);
     }
     ++loop.frame;

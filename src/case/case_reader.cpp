@@ -353,6 +353,10 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     else
       s->fail("scheme", fmt::format("unknown scheme '{}' (known: staggered, collocated)", scheme));
     c.filter = s->boolean("filter", true);
+    const std::string velocity_update = s->string("velocity_update", "simple");
+    if (velocity_update == "simple") c.simple_velocity = true;
+    else if (velocity_update == "taylor_galerkin") c.simple_velocity = false;
+    else s->fail("velocity_update", fmt::format("unknown value '{}' (known: simple, taylor_galerkin)", velocity_update));
     c.filter_strength = s->number("filter_strength", 0.5);
     s->require(c.filter_strength > 0.0 && c.filter_strength <= 1.0, "filter_strength",
                fmt::format("must lie in (0, 1], got {}", c.filter_strength));

@@ -159,6 +159,9 @@ struct CaseSetup {
   FluidSpec fluid;
   bool filter = true;
   double filter_strength = 0.5;
+  /// V2: the nodal velocity of step 2 by the simple scheme (method-notes §2.3), or V1's
+  /// Taylor-Galerkin step 2 (solver.velocity_update = "taylor_galerkin", for comparison).
+  bool simple_velocity = true;
   SourceCoupling coupling = SourceCoupling::additive;
 
   // output

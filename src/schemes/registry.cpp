@@ -24,6 +24,11 @@ std::vector<Entry<Dim>>& entries() {
     builtin.push_back(
         {{"v3", "saturated soil, small deformation: v-p_w fractional step with PCG (method-notes §5.3)", true},
          make_v3_scheme<Dim>});
+    builtin.push_back({{"v2",
+                        "dry soil, large deformation: moving particles, Jaumann rate, simple second step "
+                        "(method-notes §5.2)",
+                        false},
+                       make_v2_scheme<Dim>});
     return builtin;
   }();
   return list;

@@ -40,10 +40,12 @@ std::vector<std::string> scheme_names();
 template <int Dim>
 const SchemeInfo* find_scheme(const std::string& name);
 
-// The built-in schemes (schemes/v1_scheme.cpp, schemes/v3_scheme.cpp).
+// The built-in schemes (schemes/v1_scheme.cpp, v2_scheme.cpp, v3_scheme.cpp).
 template <int Dim>
 std::unique_ptr<Scheme> make_v1_scheme(StaggeredModel<Dim>& model);
 template <int Dim>
 std::unique_ptr<Scheme> make_v3_scheme(StaggeredModel<Dim>& model);
+template <int Dim>
+std::unique_ptr<Scheme> make_v2_scheme(StaggeredModel<Dim>& model);
 
 }  // namespace rktsph

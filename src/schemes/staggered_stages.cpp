@@ -78,14 +78,14 @@ void ViscoplasticSources<Dim>::integrate(double tau, const SourceRuns& runs, Fie
 
 // ---- step 1
 
-template <int Dim, class PressureTerm>
-StressPointHalfStep<Dim, PressureTerm>::StressPointHalfStep(StaggeredModel<Dim>& model,
-                                                            std::shared_ptr<ViscoplasticSources<Dim>> sources,
-                                                            PressureTerm pressure)
+template <int Dim, class PressureTerm, class Motion>
+StressPointHalfStep<Dim, PressureTerm, Motion>::StressPointHalfStep(StaggeredModel<Dim>& model,
+                                                                    std::shared_ptr<ViscoplasticSources<Dim>> sources,
+                                                                    PressureTerm pressure)
     : m_(model), sources_(std::move(sources)), pressure_(pressure) {}
 
-template <int Dim, class PressureTerm>
-void StressPointHalfStep<Dim, PressureTerm>::run(const StepContext& c) {
+template <int Dim, class PressureTerm, class Motion>
+void StressPointHalfStep<Dim, PressureTerm, Motion>::run(const StepContext& c) {
   constexpr int NS = kStressComponents<Dim>;
   const double tau = 0.5 * c.dt;
   const Vec<Dim> body = m_.body_force(c.t + 0.5 * tau);
@@ -93,7 +93,8 @@ void StressPointHalfStep<Dim, PressureTerm>::run(const StepContext& c) {
   for (int d = 0; d < Dim; ++d) b[d] = body[d];
   const double cd = c.damping;
   const CorrectedOperator<Dim>& op = m_.to_stress_points;
-  const ParticleSet<Dim>& sp = m_.stress_points;
+  ParticleSet<Dim>& sp = m_.stress_points;
+  const double dt = c.dt;
   // Shared row patterns (operators/corrected_operator.hpp): pair k of stress point e has the
   // source base[e] + off[k]; on a lattice the few patterns' weights stay in the L1 cache.
   const Index* base = op.base.data();
@@ -151,6 +152,18 @@ void StressPointHalfStep<Dim, PressureTerm>::run(const StepContext& c) {
             }
           }
           for (int i = 0; i < Dim; ++i) sp_v(e, i) = damped_velocity(bar_v[i], dv[i] + b[i], cd, tau);
+          if constexpr (Motion::kMoving) {
+            // V2 (method-notes §1.3, §5.2): the Jaumann rotation of the interpolated stress over
+            // the half step (the flux and the source then act on the rotated stress); the
+            // density by continuity over the step, with d at t^n; the position with v^{n+1/2}.
+            jaumann_rotate<Dim>(grad_v, tau, bar_s);
+            double tr = 0.0;
+            for (int k = 0; k < Dim; ++k) tr += grad_v[k][k];
+            const double mass = sp.volume[eu] * sp.density[eu];
+            sp.density[eu] /= 1.0 + dt * tr;
+            sp.volume[eu] = mass / sp.density[eu];
+            for (int d = 0; d < Dim; ++d) sp.position[eu][d] += dt * sp_v(e, d);
+          }
           for (int s = 0; s < NS; ++s) sp_s(e, s) = bar_s[s] + tau * dsig[s];
           if (sources) {
             double* start = src.sigma_start(e);
@@ -178,12 +191,13 @@ void StressPointHalfStep<Dim, PressureTerm>::run(const StepContext& c) {
 
 // ---- step 2
 
-template <int Dim>
-NodeFullStep<Dim>::NodeFullStep(StaggeredModel<Dim>& model, std::shared_ptr<ViscoplasticSources<Dim>> sources)
+template <int Dim, class Motion, class Velocity>
+NodeFullStep<Dim, Motion, Velocity>::NodeFullStep(StaggeredModel<Dim>& model,
+                                                  std::shared_ptr<ViscoplasticSources<Dim>> sources)
     : m_(model), sources_(std::move(sources)) {}
 
-template <int Dim>
-void NodeFullStep<Dim>::run(const StepContext& c) {
+template <int Dim, class Motion, class Velocity>
+void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
   constexpr int NS = kStressComponents<Dim>;
   const double dt = c.dt;
   const Vec<Dim> body = m_.body_force(c.t + 0.5 * dt);
@@ -192,7 +206,7 @@ void NodeFullStep<Dim>::run(const StepContext& c) {
   const double cd = c.damping;
   const double t_half = c.t + 0.5 * dt;
   const CorrectedOperator<Dim>& op = m_.to_nodes;
-  const ParticleSet<Dim>& nodes = m_.nodes;
+  ParticleSet<Dim>& nodes = m_.nodes;
   const auto sp_v = std::as_const(m_.stress_points).view(m_.fields.sp_velocity);
   const auto sp_s = std::as_const(m_.stress_points).view(m_.fields.sp_stress);
   auto node_v = m_.nodes.view(m_.fields.velocity);
@@ -265,7 +279,23 @@ void NodeFullStep<Dim>::run(const StepContext& c) {
           m_.materials.elastic[static_cast<std::size_t>(mat)](grad_v, dsig);
           double* v = node_v[i];
           double* s = node_s[i];
-          for (int d = 0; d < Dim; ++d) v[d] = damped_velocity(v[d], dv[d] + b[d], cd, dt);
+          if constexpr (Velocity::kSimple) {
+            // The simple scheme (method-notes §2.3): from the stress points' velocity, half a step.
+            for (int d = 0; d < Dim; ++d) v[d] = damped_velocity(v_half[d], dv[d] + b[d], cd, 0.5 * dt);
+          } else {
+            for (int d = 0; d < Dim; ++d) v[d] = damped_velocity(v[d], dv[d] + b[d], cd, dt);
+          }
+          if constexpr (Motion::kMoving) {
+            // V2: the Jaumann rotation over the step with the spin of v^{n+1/2}; the density by
+            // continuity; the position moved with the displacement (x - X = u).
+            jaumann_rotate<Dim>(grad_v, dt, s);
+            double tr = 0.0;
+            for (int k = 0; k < Dim; ++k) tr += grad_v[k][k];
+            const double mass = nodes.volume[iu] * nodes.density[iu];
+            nodes.density[iu] /= 1.0 + dt * tr;
+            nodes.volume[iu] = mass / nodes.density[iu];
+            for (int d = 0; d < Dim; ++d) nodes.position[iu][d] += dt * v_half[d];
+          }
           if (sources) {
             double* start = src.sigma_start(i);
             double* rate = src.flux_rate(i);
@@ -283,13 +313,13 @@ void NodeFullStep<Dim>::run(const StepContext& c) {
   if (sources) src.integrate(dt, m_.node_sources, node_s, m_.nodes.view(m_.fields.history));
 }
 
-template <int Dim>
-void NodeFullStep<Dim>::save(io::StateArchive& a, const std::string& prefix) const {
+template <int Dim, class Motion, class Velocity>
+void NodeFullStep<Dim, Motion, Velocity>::save(io::StateArchive& a, const std::string& prefix) const {
   a.put_integer(prefix + "max_source_substeps", sources_->max_substeps());
 }
 
-template <int Dim>
-void NodeFullStep<Dim>::load(const io::StateArchive& a, const std::string& prefix) {
+template <int Dim, class Motion, class Velocity>
+void NodeFullStep<Dim, Motion, Velocity>::load(const io::StateArchive& a, const std::string& prefix) {
   sources_->set_max_substeps(static_cast<long>(a.integer(prefix + "max_source_substeps")));
 }
 
@@ -357,11 +387,14 @@ void VelocityFilter<Dim>::run(const StepContext&) {
   });
 }
 
-#define RKTSPH_INSTANTIATE(D)                                     \
-  template class ViscoplasticSources<D>;                          \
-  template class StressPointHalfStep<D, NoPressureGradient>;      \
-  template class StressPointHalfStep<D, PorePressureGradient<D>>; \
-  template class NodeFullStep<D>;                                 \
+#define RKTSPH_INSTANTIATE(D)                                                  \
+  template class ViscoplasticSources<D>;                                      \
+  template class StressPointHalfStep<D, NoPressureGradient>;                  \
+  template class StressPointHalfStep<D, PorePressureGradient<D>>;             \
+  template class StressPointHalfStep<D, NoPressureGradient, MovingParticles>; \
+  template class NodeFullStep<D>;                                             \
+  template class NodeFullStep<D, MovingParticles, SimpleVelocity>;            \
+  template class NodeFullStep<D, MovingParticles, TaylorGalerkinVelocity>;    \
   template class VelocityFilter<D>;
 RKTSPH_INSTANTIATE(1)
 RKTSPH_INSTANTIATE(2)

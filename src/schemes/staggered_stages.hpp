@@ -10,6 +10,7 @@
 #include <string_view>
 #include <vector>
 
+#include "schemes/motion.hpp"
 #include "schemes/stage.hpp"
 #include "schemes/staggered_model.hpp"
 
@@ -60,8 +61,9 @@ struct PorePressureGradient {
 };
 
 /// Step 1: interpolation and gradient of the nodal state at the stress points, half step of
-/// the flux and the sources (method-notes §5.1 step 1).
-template <int Dim, class PressureTerm = NoPressureGradient>
+/// the flux and the sources (method-notes §5.1 step 1). Moving particles (V2, §5.2): the
+/// Jaumann rotation over the half step, the continuity equation, the positions.
+template <int Dim, class PressureTerm = NoPressureGradient, class Motion = FixedParticles>
 class StressPointHalfStep final : public Stage {
  public:
   StressPointHalfStep(StaggeredModel<Dim>& model, std::shared_ptr<ViscoplasticSources<Dim>> sources,
@@ -77,8 +79,9 @@ class StressPointHalfStep final : public Stage {
 
 /// Step 2: gradient of the stress points' state at the nodes, full step of the flux and the
 /// sources; the displacement from the stress points' velocity (method-notes §5.1 step 2, §0.3
-/// item 8).
-template <int Dim>
+/// item 8). Moving particles (V2): the Jaumann rotation, the continuity equation, the
+/// positions moved with the displacement; the velocity by V1's step 2 or the simple scheme.
+template <int Dim, class Motion = FixedParticles, class Velocity = TaylorGalerkinVelocity>
 class NodeFullStep final : public Stage {
  public:
   NodeFullStep(StaggeredModel<Dim>& model, std::shared_ptr<ViscoplasticSources<Dim>> sources);

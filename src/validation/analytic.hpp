@@ -56,3 +56,56 @@ struct ElasticBar {
 };
 
 }  // namespace rktsph::analytic
+
+namespace rktsph::analytic {
+
+/// A 1D bar 0 <= X in large deformation: the Jaumann hypoelastic law in uniaxial strain gives
+/// sigma = M ln(lambda), lambda = dx/dX, and the p-system rho0 v_t = sigma_X, lambda_t = v_X
+/// with the Lagrangian wave speed C(lambda) = sqrt(M / (rho0 lambda)) (docs/cases.md Case 7).
+/// The end X = 0 is driven at v(0, t) = v0 from t = 0 into the bar at rest: v0 > 0 pushes (one
+/// shock), v0 < 0 pulls (a rarefaction fan).
+struct LargeStrainBar {
+  double M;     // constrained modulus, Pa
+  double rho0;  // reference density, kg/m^3
+  double v0;    // m/s
+
+  double c0() const { return std::sqrt(M / rho0); }
+  double wave_speed(double lambda) const { return std::sqrt(M / (rho0 * lambda)); }
+  /// The state behind the wave: rho0 v0^2 / M = (-ln l)(1 - l) for the shock (push), and
+  /// l = (1 + |v0| / (2 C0))^2 behind the fan (pull).
+  double lambda_behind() const {
+    if (v0 <= 0.0) {
+      const double r = 1.0 + std::abs(v0) / (2.0 * c0());
+      return r * r;
+    }
+    const double target = rho0 * v0 * v0 / M;
+    double lo = 1e-6, hi = 1.0 - 1e-15;  // f decreases from +inf to 0 on (0, 1)
+    for (int k = 0; k < 200; ++k) {
+      const double mid = 0.5 * (lo + hi);
+      if ((-std::log(mid)) * (1.0 - mid) > target) lo = mid;
+      else hi = mid;
+    }
+    return 0.5 * (lo + hi);
+  }
+  /// Lagrangian speed of the shock (push).
+  double shock_speed() const { return v0 / (1.0 - lambda_behind()); }
+  /// The fan's head and tail speeds (pull).
+  double fan_head() const { return c0(); }
+  double fan_tail() const { return wave_speed(lambda_behind()); }
+
+  double lambda(double X, double t) const {
+    if (t <= 0.0) return 1.0;
+    if (v0 > 0.0) return X < shock_speed() * t ? lambda_behind() : 1.0;
+    const double xi = X / t;
+    if (xi >= fan_head()) return 1.0;
+    if (xi <= fan_tail()) return lambda_behind();
+    return M * t * t / (rho0 * X * X);  // inside the fan: C(lambda) = X / t
+  }
+  double velocity(double X, double t) const {
+    if (v0 > 0.0) return X < shock_speed() * t ? v0 : 0.0;
+    return -2.0 * c0() * (std::sqrt(lambda(X, t)) - 1.0);
+  }
+  double stress(double X, double t) const { return M * std::log(lambda(X, t)); }
+};
+
+}  // namespace rktsph::analytic

@@ -1,0 +1,43 @@
+// V2: the staggered RKT-SPH step for dry soil in large deformation (method-notes §5.2):
+//   0. neighbours and operators rebuilt from the current positions (never frozen);
+//   1. stress points: half step from the nodes, with the Jaumann rotation, the continuity
+//      equation and the new positions;
+//   2. nodes: the stress by step 2 with the Jaumann rotation, the velocity by the simple
+//      scheme (solver.velocity_update = "simple", default) or V1's step 2
+//      ("taylor_galerkin"), continuity, positions and displacements;
+//   3. prescribed components at t^{n+1} (and V1's velocity filter with the Taylor-Galerkin
+//      update only: the simple scheme has no nodal mode to filter).
+#include <chrono>
+#include <memory>
+
+#include "schemes/registry.hpp"
+#include "schemes/staggered_stages.hpp"
+#include "schemes/v2_stages.hpp"
+
+namespace rktsph {
+
+template <int Dim>
+std::unique_ptr<Scheme> make_v2_scheme(StaggeredModel<Dim>& model) {
+  auto scheme = std::make_unique<Scheme>("v2");
+  auto sources = std::make_shared<ViscoplasticSources<Dim>>(model);
+  scheme->add(std::make_unique<RebuildOperators<Dim>>(model));
+  scheme->add(std::make_unique<StressPointHalfStep<Dim, NoPressureGradient, MovingParticles>>(model, sources));
+  if (model.setup.simple_velocity) {
+    scheme->add(std::make_unique<NodeFullStep<Dim, MovingParticles, SimpleVelocity>>(model, sources));
+    scheme->add(std::make_unique<ApplyConstraints<Dim>>(model));
+  } else {
+    scheme->add(std::make_unique<NodeFullStep<Dim, MovingParticles, TaylorGalerkinVelocity>>(model, sources));
+    scheme->add(std::make_unique<ApplyConstraints<Dim>>(model));
+    if (model.setup.filter) {
+      scheme->add(std::make_unique<VelocityFilter<Dim>>(model, model.setup.filter_strength));
+      scheme->add(std::make_unique<ApplyConstraints<Dim>>(model));
+    }
+  }
+  return scheme;
+}
+
+template std::unique_ptr<Scheme> make_v2_scheme<1>(StaggeredModel<1>&);
+template std::unique_ptr<Scheme> make_v2_scheme<2>(StaggeredModel<2>&);
+template std::unique_ptr<Scheme> make_v2_scheme<3>(StaggeredModel<3>&);
+
+}  // namespace rktsph
