@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include <fmt/format.h>
+#include <nlohmann/json.hpp>
 
 #include "app/run_loop.hpp"
 #include "core/error.hpp"
@@ -45,9 +46,19 @@ void remove_temporaries(const fs::path& out) {
   }
 }
 
+// summary.json before anything else is done: a run killed during its set-up still leaves one
+// (replaced by the loop's "running" one, then by the final one).
+void write_starting_summary(const fs::path& out, const std::string& case_file) {
+  io::write_file_atomically(
+      (out / "summary.json").string(),
+      fmt::format("{{\n  \"case\": {},\n  \"status\": \"starting\",\n  \"message\": \"\",\n  \"version\": \"{}\",\n  "
+                  "\"git_revision\": \"{}\"\n}}\n",
+                  nlohmann::json(case_file).dump(), kVersion, kGitRevision));
+}
+
 // Make `out` ready for a fresh run: create it, or clear the output of an earlier run in it.
 // Refuses the filesystem root and a folder that holds something else (InputError).
-void prepare_output_folder(const fs::path& out, bool quiet) {
+void prepare_output_folder(const fs::path& out, const std::string& case_file, bool quiet) {
   std::error_code ec;
   const fs::path absolute = fs::absolute(out, ec);
   if (out.empty() || (!ec && absolute == absolute.root_path())) {
@@ -64,7 +75,8 @@ void prepare_output_folder(const fs::path& out, bool quiet) {
     }
     // The output of an earlier run: its frames, tables and checkpoint go (stale frames would
     // otherwise sit beside the new ones in ParaView).
-    for (const char* f : {"summary.json", "probes.csv", "energy.csv", "nodes.pvd", "elements.pvd", "case.resolved.toml"}) {
+    write_starting_summary(out, case_file);  // replaces the old one, never leaves none
+    for (const char* f : {"probes.csv", "energy.csv", "nodes.pvd", "elements.pvd", "case.resolved.toml"}) {
       fs::remove(out / f, ec);
     }
     fs::remove_all(out / "vtu", ec);
@@ -74,6 +86,7 @@ void prepare_output_folder(const fs::path& out, bool quiet) {
   }
   fs::create_directories(out / "vtu", ec);
   if (ec) throw InputError(io::system_error_text("create the output folder", out.string(), ec.value()));
+  write_starting_summary(out, case_file);
 }
 
 std::string document_text(const CaseDocument& doc) {
@@ -98,7 +111,7 @@ int run_case(const RunOptions& opt) {
   (void)case_dimension(input.document);  // checked before the folder is touched
   const std::string case_name = fs::path(opt.case_file).stem().string();
   input.out = opt.out_dir.empty() ? fs::path("out") / case_name : fs::path(opt.out_dir);
-  prepare_output_folder(input.out, opt.quiet);
+  prepare_output_folder(input.out, opt.case_file, opt.quiet);
   io::write_file_atomically((input.out / "case.resolved.toml").string(),
                             fmt::format("# resolved input of {} (rktsph {}, {})\n{}\n", opt.case_file, kVersion,
                                         kGitRevision, document_text(input.document)),
