@@ -316,6 +316,9 @@ int run_loop(const LoopInput& in) {
                                 ? nlohmann::json(solver.clock().damping_off_time())
                                 : nlohmann::json(nullptr);
     j["peak_kinetic_energy"] = solver.clock().peak_kinetic_energy();
+    for (const auto& stage : solver.scheme().stages()) {
+      for (const auto& [key, value] : stage->report()) j["stages"][std::string(stage->name())][key] = value;
+    }
     if (pressure != nullptr) {
       // V3: the pore-pressure solve (method-notes §2.4): PCG iterations, residual, time share.
       const PressureSolveStats& ps = pressure->stats();

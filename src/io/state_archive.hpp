@@ -5,6 +5,7 @@
 // The archive is what the HDF5 file holds, one dataset per key; its checksum covers every key
 // and value, so a damaged file is recognised on reading.
 #include <cstdint>
+#include <cstring>
 #include <map>
 #include <string>
 #include <variant>
@@ -45,12 +46,20 @@ class StateArchive {
   const std::map<std::string, Value>& values() const { return values_; }
   std::map<std::string, Value>& values() { return values_; }
 
-  /// FNV-1a (64 bit) over every key and value, in key order.
+  /// A 64-bit hash of every key and value, in key order: FNV-1a over 8-byte words (then the
+  /// tail bytes), which reads a checkpoint of 10^5 particles in a few milliseconds.
   std::uint64_t checksum() const {
     std::uint64_t h = 0xcbf29ce484222325ULL;
     auto mix = [&](const void* data, std::size_t n) {
       const auto* p = static_cast<const unsigned char*>(data);
-      for (std::size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 0x100000001b3ULL;
+      std::size_t i = 0;
+      for (; i + 8 <= n; i += 8) {
+        std::uint64_t w;
+        std::memcpy(&w, p + i, 8);
+        h = (h ^ w) * 0x100000001b3ULL;
+        h ^= h >> 29;
+      }
+      for (; i < n; ++i) h = (h ^ p[i]) * 0x100000001b3ULL;
     };
     for (const auto& [key, value] : values_) {
       mix(key.data(), key.size());

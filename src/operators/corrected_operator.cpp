@@ -203,6 +203,59 @@ bool row_weights(const std::vector<Pair<Dim>>& pairs, const ParticleSet<Dim>& so
   return ok;
 }
 
+// The weights of one row for the rebuild of moving particles (rebuild_corrected_operator): the
+// system of row_weights, with the kernel's value and derivative from one evaluation and the
+// pair data in flat arrays. Writes interp[k] and grad[k] of the row's n pairs; returns false if
+// the row is degenerate (then Shepard interpolation and the plain kernel gradient).
+template <int Dim>
+bool row_weights_fast(const Pair<Dim>* pairs, std::size_t n, const ParticleSet<Dim>& sources,
+                      const CubicSplineKernel<Dim>& kernel, double* basis, double* interp,
+                      std::array<double, Dim>* grad) {
+  constexpr int N = Dim + 1;
+  using MatN = Eigen::Matrix<double, N, N>;
+  const double h = kernel.h(), inv_h = 1.0 / h;
+  MatN M = MatN::Zero();
+  double shepard = 0.0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const Pair<Dim>& p = pairs[k];
+    const double V = sources.volume[static_cast<std::size_t>(p.b)];
+    double W, dW;
+    kernel.value_and_derivative(p.r, W, dW);
+    double* w = basis + k * N;
+    w[0] = V * W;
+    const double g = p.r > 0.0 ? V * h * dW / p.r : 0.0;
+    double rel[Dim];  // (x_b - x_a)/h
+    for (int d = 0; d < Dim; ++d) {
+      w[1 + d] = g * p.x_ab[d];
+      rel[d] = -p.x_ab[d] * inv_h;
+    }
+    // M += w (x) [1, (x_b - x_a)/h]
+    for (int i = 0; i < N; ++i) {
+      M(i, 0) += w[i];
+      for (int d = 0; d < Dim; ++d) M(i, 1 + d) += w[i] * rel[d];
+    }
+    shepard += w[0];
+  }
+  const bool ok = n > 0 && std::abs(M.determinant()) > 1e-8;
+  const MatN Minv = ok ? MatN(M.inverse()) : MatN::Identity();
+  for (std::size_t k = 0; k < n; ++k) {
+    const double* w = basis + k * N;
+    double c[N];
+    if (ok) {
+      for (int i = 0; i < N; ++i) {
+        c[i] = 0.0;
+        for (int j = 0; j < N; ++j) c[i] += Minv(i, j) * w[j];
+      }
+    } else {
+      for (int i = 0; i < N; ++i) c[i] = w[i];
+      c[0] = shepard > 0.0 ? w[0] / shepard : 0.0;
+    }
+    interp[k] = c[0];
+    for (int d = 0; d < Dim; ++d) grad[k][static_cast<std::size_t>(d)] = c[d + 1] * inv_h;
+  }
+  return ok;
+}
+
 }  // namespace
 
 template <int Dim>
@@ -321,6 +374,75 @@ CorrectedOperator<Dim> build_corrected_operator(const std::vector<Vec<Dim>>& tar
 }
 
 template <int Dim>
+void rebuild_corrected_operator(const Relation<Dim>& candidates, const std::vector<Vec<Dim>>& targets,
+                                const ParticleSet<Dim>& sources, const CubicSplineKernel<Dim>& kernel,
+                                CorrectedOperator<Dim>& op, const exec::Threads& policy) {
+  const auto nt = static_cast<Index>(targets.size());
+  if (candidates.rows() != nt || !candidates.options().sorted) {
+    throw SolverError("corrected operator: the candidate relation must have one sorted row per target");
+  }
+  const double r_max = kernel.support_radius() * (1.0 - kSupportGap);
+  const double r2 = r_max * r_max;
+  // Pass 1: the pairs of every row, and the CSR starts.
+  op.base.resize(static_cast<std::size_t>(nt));
+  op.pattern.resize(static_cast<std::size_t>(nt));
+  op.pattern_start.resize(static_cast<std::size_t>(nt) + 1);
+  op.pattern_start[0] = 0;
+  exec::particle_for(policy, nt, [&](Index a) {
+    Index n = 0;
+    const Vec<Dim>& xa = targets[static_cast<std::size_t>(a)];
+    for (const Index b : candidates.row(a)) n += (xa - sources.position[static_cast<std::size_t>(b)]).squaredNorm() < r2 ? 1 : 0;
+    op.pattern_start[static_cast<std::size_t>(a) + 1] = n;
+  });
+  for (Index a = 0; a < nt; ++a) {
+    op.pattern_start[static_cast<std::size_t>(a) + 1] += op.pattern_start[static_cast<std::size_t>(a)];
+    op.pattern[static_cast<std::size_t>(a)] = a;
+  }
+  const auto pairs = static_cast<std::size_t>(op.pattern_start.back());
+  op.offset.resize(pairs);
+  op.interp.resize(pairs);
+  op.grad.resize(pairs);
+  // Pass 2: the weights, row by row (method-notes §3.2), in fixed blocks of rows.
+  const Index nblocks = (nt + kBuildBlock - 1) / kBuildBlock;
+  Index degenerate = 0;
+  static thread_local std::vector<Index> block_degenerate;
+  block_degenerate.assign(static_cast<std::size_t>(nblocks), 0);
+  exec::particle_for(
+      policy, nblocks,
+      [&](Index blk) {
+        // Work space of this thread, kept from call to call (no allocation once grown).
+        static thread_local std::vector<Pair<Dim>> row;
+        static thread_local std::vector<double> basis;
+        const Index end = std::min(nt, (blk + 1) * kBuildBlock);
+        for (Index a = blk * kBuildBlock; a < end; ++a) {
+          const auto au = static_cast<std::size_t>(a);
+          row.clear();
+          for (const Index b : candidates.row(a)) {
+            const Vec<Dim> x_ab = targets[au] - sources.position[static_cast<std::size_t>(b)];
+            const double d2 = x_ab.squaredNorm();
+            if (d2 < r2) row.push_back({b, x_ab, std::sqrt(d2)});
+          }
+          if (basis.size() < row.size() * (Dim + 1)) basis.resize(row.size() * (Dim + 1));
+          const auto k0 = static_cast<std::size_t>(op.pattern_start[au]);
+          if (!row_weights_fast<Dim>(row.data(), row.size(), sources, kernel, basis.data(), &op.interp[k0],
+                                     &op.grad[k0])) {
+            ++block_degenerate[static_cast<std::size_t>(blk)];
+          }
+          const Index b0 = row.empty() ? 0 : row.front().b;
+          op.base[au] = b0;
+          for (std::size_t j = 0; j < row.size(); ++j) op.offset[k0 + j] = row[j].b - b0;
+        }
+      },
+      exec::Schedule::dynamic, nt);
+  for (const Index d : block_degenerate) degenerate += d;
+  // One row per run: the rows share no pattern.
+  op.run_start.resize(static_cast<std::size_t>(nt) + 1);
+  for (Index a = 0; a <= nt; ++a) op.run_start[static_cast<std::size_t>(a)] = a;
+  op.pair_count = pairs;
+  op.degenerate_rows = degenerate;
+}
+
+template <int Dim>
 RelationOptions difference_gradient_relation_options(const CubicSplineKernel<Dim>& kernel) {
   return {kernel.support_radius(), 1, true};
 }
@@ -335,8 +457,12 @@ DifferenceGradient<Dim> build_difference_gradient(const Relation<Dim>& relation,
   DifferenceGradient<Dim> g;
   g.row_start.push_back(0);
   std::vector<Pair<Dim>> pairs;
+  // A wider relation (a Verlet list with a skin) is cut back to the support.
+  const bool filter = relation.options().radius > kernel.support_radius();
+  const double r2 = kernel.support_radius() * kernel.support_radius();
   for (Index a = 0; a < relation.rows(); ++a) {
     row_pairs(relation, a, targets[static_cast<std::size_t>(a)], sources, pairs);
+    if (filter) std::erase_if(pairs, [&](const Pair<Dim>& p) { return p.x_ab.squaredNorm() >= r2; });
     Mat<Dim> A = Mat<Dim>::Zero();
     for (const auto& p : pairs) {
       const double V = sources.volume[static_cast<std::size_t>(p.b)];
@@ -381,6 +507,9 @@ DifferenceGradient<Dim> build_difference_gradient(const std::vector<Vec<Dim>>& t
                                                             const OperatorOptions&);                                 \
   template CorrectedOperator<D> build_corrected_operator<D>(const std::vector<Vec<D>>&, const ParticleSet<D>&,       \
                                                             const CubicSplineKernel<D>&, const OperatorOptions&);    \
+  template void rebuild_corrected_operator<D>(const Relation<D>&, const std::vector<Vec<D>>&, const ParticleSet<D>&, \
+                                              const CubicSplineKernel<D>&, CorrectedOperator<D>&,              \
+                                              const exec::Threads&);                                           \
   template DifferenceGradient<D> build_difference_gradient<D>(const Relation<D>&, const std::vector<Vec<D>>&,        \
                                                               const ParticleSet<D>&, const CubicSplineKernel<D>&);   \
   template DifferenceGradient<D> build_difference_gradient<D>(const std::vector<Vec<D>>&, const std::vector<Index>&, \

@@ -26,6 +26,7 @@
 
 #include "core/kernel.hpp"
 #include "core/types.hpp"
+#include "core/execution.hpp"
 #include "neighbours/relation.hpp"
 #include "particles/particle_set.hpp"
 
@@ -116,6 +117,16 @@ template <int Dim>
 CorrectedOperator<Dim> build_corrected_operator(const std::vector<Vec<Dim>>& targets, const ParticleSet<Dim>& sources,
                                                 const CubicSplineKernel<Dim>& kernel,
                                                 const OperatorOptions& options = {});
+
+/// Rebuild `op` in place for particles that have moved: one pattern per row (plain CSR), the
+/// sources of row a those of `candidates` row a (sorted, e.g. a Verlet list with a skin) that lie
+/// within the support (less the relative 1e-10 of operator_relation_options). The weights are
+/// those of build_corrected_operator without pattern sharing; op's storage is reused, so once it
+/// has grown nothing is allocated.
+template <int Dim>
+void rebuild_corrected_operator(const Relation<Dim>& candidates, const std::vector<Vec<Dim>>& targets,
+                                const ParticleSet<Dim>& sources, const CubicSplineKernel<Dim>& kernel,
+                                CorrectedOperator<Dim>& op, const exec::Threads& policy = {});
 
 /// Difference-form gradients at `targets` over `relation` (built with
 /// difference_gradient_relation_options, one row per target).

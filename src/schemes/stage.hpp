@@ -5,6 +5,8 @@
 #include <cstddef>
 #include <string>
 #include <string_view>
+#include <utility>
+#include <vector>
 
 namespace rktsph {
 namespace io {
@@ -35,6 +37,8 @@ class Stage {
   /// that the run continues bit for bit. Most stages have none.
   virtual void save(io::StateArchive& /*archive*/, const std::string& /*prefix*/) const {}
   virtual void load(const io::StateArchive& /*archive*/, const std::string& /*prefix*/) {}
+  /// Figures for the log and summary.json (counts, seconds), by name; most stages have none.
+  virtual std::vector<std::pair<std::string, double>> report() const { return {}; }
 };
 
 }  // namespace rktsph

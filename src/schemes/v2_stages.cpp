@@ -1,36 +1,65 @@
 #include "schemes/v2_stages.hpp"
 
+#include <algorithm>
 #include <chrono>
 
 #include "operators/corrected_operator.hpp"
 
 namespace rktsph {
 
+namespace {
+// The skin of the Verlet lists, in units of h: wider lists cost more pairs to test every step,
+// narrower ones more searches (measured on the benchmark block, docs/method-notes.md §3.8).
+constexpr double kSkinOverH = 0.3;
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+}  // namespace
+
 template <int Dim>
 RebuildOperators<Dim>::RebuildOperators(StaggeredModel<Dim>& model)
-    : m_(model), constrained_positions_(model.constraints.constrained().size()) {}
+    : m_(model), skin_(kSkinOverH * model.kernel.h()), constrained_positions_(model.constraints.constrained().size()) {}
+
+template <int Dim>
+void RebuildOperators<Dim>::build_relations() {
+  const auto t0 = Clock::now();
+  RelationOptions rel = operator_relation_options(m_.kernel);
+  rel.radius += skin_;
+  to_stress_points_.build(m_.stress_points.position, m_.nodes.position, rel, m_.policy);
+  to_nodes_.build(m_.nodes.position, m_.stress_points.position, rel, m_.policy);
+  RelationOptions diff = difference_gradient_relation_options(m_.kernel);
+  diff.radius += skin_;
+  constrained_.build(constrained_positions_, m_.stress_points.position, diff, m_.policy);
+  nodes_at_build_ = m_.nodes.position;
+  stress_points_at_build_ = m_.stress_points.position;
+  ++relation_builds_;
+  relation_seconds_ += since(t0);
+}
 
 template <int Dim>
 void RebuildOperators<Dim>::run(const StepContext&) {
-  const auto t0 = std::chrono::steady_clock::now();
-  OperatorOptions options;
-  options.share_patterns = false;
-  const RelationOptions rel = operator_relation_options(m_.kernel);
-  to_stress_points_.build(m_.stress_points.position, m_.nodes.position, rel, m_.policy);
-  m_.to_stress_points = build_corrected_operator<Dim>(to_stress_points_, m_.stress_points.position, m_.nodes,
-                                                      m_.kernel, options);
-  to_nodes_.build(m_.nodes.position, m_.stress_points.position, rel, m_.policy);
-  m_.to_nodes = build_corrected_operator<Dim>(to_nodes_, m_.nodes.position, m_.stress_points, m_.kernel, options);
   const auto& which = m_.constraints.constrained();
   for (std::size_t k = 0; k < which.size(); ++k) {
     constrained_positions_[k] = m_.nodes.position[static_cast<std::size_t>(which[k])];
   }
-  constrained_.build(constrained_positions_, m_.stress_points.position, difference_gradient_relation_options(m_.kernel),
-                     m_.policy);
+  // Any pair's distance changed by at most the sum of two displacements since the last search.
+  double moved = 0.0;
+  if (relation_builds_ > 0) {
+    for (std::size_t i = 0; i < nodes_at_build_.size(); ++i) {
+      moved = std::max(moved, (m_.nodes.position[i] - nodes_at_build_[i]).squaredNorm());
+    }
+    for (std::size_t i = 0; i < stress_points_at_build_.size(); ++i) {
+      moved = std::max(moved, (m_.stress_points.position[i] - stress_points_at_build_[i]).squaredNorm());
+    }
+  }
+  if (relation_builds_ == 0 || 2.0 * std::sqrt(moved) >= skin_) build_relations();
+  const auto t0 = Clock::now();
+  rebuild_corrected_operator<Dim>(to_stress_points_, m_.stress_points.position, m_.nodes, m_.kernel,
+                                  m_.to_stress_points, m_.policy);
+  rebuild_corrected_operator<Dim>(to_nodes_, m_.nodes.position, m_.stress_points, m_.kernel, m_.to_nodes, m_.policy);
   m_.constrained_gradient =
       build_difference_gradient<Dim>(constrained_, constrained_positions_, m_.stress_points, m_.kernel);
-  ++rebuilds_;
-  seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  ++operator_builds_;
+  operator_seconds_ += since(t0);
 }
 
 template class RebuildOperators<1>;
