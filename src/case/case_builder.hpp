@@ -108,6 +108,13 @@ class CaseBuilder {
     boundary(region, function).pore_pressure = pore_pressure;
     return *this;
   }
+  /// 2D: an initial rigid motion v = velocity + omega e_z x (x - centre).
+  CaseBuilder& initial_velocity(const Vec<Dim>& velocity, double omega = 0.0, const Vec<Dim>& centre = Vec<Dim>::Zero()) {
+    c_.initial_velocity = velocity;
+    c_.initial_angular_velocity = omega;
+    c_.initial_rotation_centre = centre;
+    return *this;
+  }
   CaseBuilder& initial_stress(const Sym6& uniform) {
     c_.initial_stress = InitialStressKind::uniform;
     c_.uniform_stress = uniform;

@@ -145,6 +145,10 @@ struct CaseSetup {
   std::optional<double> surface_level;  // geostatic ground surface (vertical axis = last axis)
   Sym6 uniform_stress{};                // uniform initial stress (xx, yy, zz, xy, yz, xz), Pa
   Vec<Dim> initial_velocity = Vec<Dim>::Zero();
+  /// 2D: a rigid rotation added to it, v += omega e_z x (x - centre) (rad/s, counter-clockwise
+  /// positive), so that a spinning or swinging body needs no boundary entry per node.
+  double initial_angular_velocity = 0.0;
+  Vec<Dim> initial_rotation_centre = Vec<Dim>::Zero();
 
   // time
   double end_time = 0.0;

@@ -179,6 +179,13 @@ void StaggeredModel<Dim>::set_initial_state() {
   for (Index i = 0; i < nn; ++i) {
     const auto iu = static_cast<std::size_t>(i);
     for (int d = 0; d < Dim; ++d) v(i, d) = setup.initial_velocity[d];
+    if constexpr (Dim == 2) {
+      if (setup.initial_angular_velocity != 0.0) {
+        const Vec<Dim> r = nodes.position[iu] - setup.initial_rotation_centre;
+        v(i, 0) -= setup.initial_angular_velocity * r[1];
+        v(i, 1) += setup.initial_angular_velocity * r[0];
+      }
+    }
     const int m = nodes.material[iu];
     if (setup.initial_stress == InitialStressKind::geostatic) {
       // method-notes §4.2 option A: sigma_v = -rho g (H - z), lateral = K0 sigma_v.

@@ -12,6 +12,7 @@
 #include "../support/test_util.hpp"
 #include "case/case_builder.hpp"
 #include "schemes/simulation.hpp"
+#include "operators/corrected_operator.hpp"
 #include "schemes/v2_stages.hpp"
 
 namespace rktsph {
@@ -113,6 +114,34 @@ TEST(V2, RebuiltOperatorsAreExactForLinearFieldsOnMovedParticles) {
   EXPECT_LT(worst_value, 1e-11);
   EXPECT_LT(worst_grad, 1e-9);
   EXPECT_EQ(op.degenerate_rows, 0);
+}
+
+// The Verlet lists (searched with a skin, kept while the particles move less than half of it)
+// give the operators of a fresh search at the current positions, bit for bit.
+TEST(V2, VerletListsGiveTheOperatorsOfAFreshSearch) {
+  const test::ThreadCount threads(1);
+  Simulation<2> sim(block(2000.0).initial_velocity(Vec<2>::Zero(), 2.0).time(0.1, 0.5).build());
+  const auto* rebuild = sim.scheme().find<RebuildOperators<2>>();
+  ASSERT_NE(rebuild, nullptr);
+  for (int n = 0; n < 40; ++n) sim.step();
+  EXPECT_GT(rebuild->relation_builds(), 1) << "the lists were searched again as the block turned";
+  EXPECT_LT(rebuild->relation_builds(), 40) << "and not every step";
+  // The scheme's own stage at the current positions (its lists searched some steps ago) against
+  // a fresh search without a skin at the same positions.
+  auto* stage = dynamic_cast<RebuildOperators<2>*>(sim.scheme().stages().front().get());
+  ASSERT_NE(stage, nullptr);
+  const long searches = stage->relation_builds();
+  stage->run({});
+  EXPECT_EQ(stage->relation_builds(), searches) << "the lists are still valid: no new search";
+  StaggeredModel<2>& m = sim.model();
+  Relation<2> fresh;
+  fresh.build(m.stress_points.position, m.nodes.position, operator_relation_options(m.kernel));
+  CorrectedOperator<2> exact;
+  rebuild_corrected_operator<2>(fresh, m.stress_points.position, m.nodes, m.kernel, exact);
+  EXPECT_EQ(m.to_stress_points.base, exact.base);
+  EXPECT_EQ(m.to_stress_points.offset, exact.offset);
+  EXPECT_EQ(m.to_stress_points.interp, exact.interp);
+  EXPECT_EQ(m.to_stress_points.pattern_start, exact.pattern_start);
 }
 
 // A collapsing block under gravity on a fixed base (V2, 3721 nodes: the loops run threaded):
