@@ -1,0 +1,168 @@
+#include "operators/free_surface.hpp"
+
+#include <cmath>
+#include <numbers>
+
+#include <Eigen/Dense>
+
+namespace rktsph {
+
+namespace {
+
+// Smallest eigenvalue of the symmetric part of B.
+template <int Dim>
+double smallest_eigenvalue(const Mat<Dim>& B) {
+  const Mat<Dim> S = 0.5 * (B + B.transpose());
+  if constexpr (Dim == 1) {
+    return S(0, 0);
+  } else if constexpr (Dim == 2) {
+    const double m = 0.5 * (S(0, 0) + S(1, 1)), d = 0.5 * (S(0, 0) - S(1, 1));
+    return m - std::sqrt(d * d + S(0, 1) * S(0, 1));
+  } else {
+    Eigen::SelfAdjointEigenSolver<Mat<Dim>> eig;
+    eig.computeDirect(S, Eigen::EigenvaluesOnly);
+    return eig.eigenvalues()[0];
+  }
+}
+
+}  // namespace
+
+template <int Dim>
+void detect_free_surface(const ParticleSet<Dim>& set, const Relation<Dim>& relation,
+                         const CubicSplineKernel<Dim>& kernel, const FreeSurfaceOptions& options,
+                         const std::vector<std::uint8_t>& previous, const std::vector<std::uint8_t>& excluded,
+                         std::vector<std::uint8_t>& flags, std::vector<Vec<Dim>>& normals,
+                         const exec::Threads& policy) {
+  const Index n = set.size();
+  const double h = kernel.h();
+  const double r2 = kernel.support_radius() * kernel.support_radius();
+  const double near2 = 2.0 * h * h;  // (sqrt(2) h)^2
+  flags.assign(static_cast<std::size_t>(n), 0);
+  normals.assign(static_cast<std::size_t>(n), Vec<Dim>::Zero());
+  std::vector<double> lambda(static_cast<std::size_t>(n), 0.0);
+  // Steps 1-3: B, the first normal, the pre-screen and the umbrella scan of the candidates.
+  exec::particle_for(policy, n, [&](Index i) {
+    const auto iu = static_cast<std::size_t>(i);
+    const Vec<Dim>& xi = set.position[iu];
+    Mat<Dim> B = Mat<Dim>::Zero();
+    Vec<Dim> g = Vec<Dim>::Zero();
+    for (const Index j : relation.row(i)) {
+      if (j == i) continue;
+      const Vec<Dim> x_ij = xi - set.position[static_cast<std::size_t>(j)];
+      const double d2 = x_ij.squaredNorm();
+      if (d2 >= r2 || d2 == 0.0) continue;
+      const double r = std::sqrt(d2);
+      const Vec<Dim> grad = kernel.derivative(r) / r * x_ij;  // grad_I W_IJ
+      const double V = set.volume[static_cast<std::size_t>(j)];
+      B -= V * x_ij * grad.transpose();  // (x_J - x_I) (x) grad_I W_IJ
+      g += V * grad;
+    }
+    lambda[iu] = smallest_eigenvalue<Dim>(B);
+    Vec<Dim> nu = std::abs(B.determinant()) > 1e-12 ? Vec<Dim>(-(B.inverse() * g)) : Vec<Dim>(-g);
+    const double len = nu.norm();
+    const Vec<Dim> normal = len > 0.0 ? Vec<Dim>(nu / len) : Vec<Dim>::Zero();
+    if (!excluded.empty() && excluded[iu] != 0) return;
+    bool surface = false;
+    if (lambda[iu] <= options.surface_below) {
+      surface = true;
+    } else if (lambda[iu] <= options.interior_above && len > 0.0) {
+      // The umbrella scan: any neighbour in the region just outside I along n makes I interior.
+      const Vec<Dim> T = xi + h * normal;
+      surface = true;
+      for (const Index j : relation.row(i)) {
+        if (j == i) continue;
+        const Vec<Dim>& xj = set.position[static_cast<std::size_t>(j)];
+        const Vec<Dim> rel = xj - xi;
+        const double d2 = rel.squaredNorm();
+        if (d2 >= r2) continue;
+        const Vec<Dim> y = xj - T;
+        bool inside;
+        if (d2 >= near2) {
+          inside = y.squaredNorm() < h * h;
+        } else if constexpr (Dim == 2) {
+          const Vec<Dim> tangent(-normal[1], normal[0]);
+          inside = std::abs(normal.dot(y)) + std::abs(tangent.dot(y)) < h;
+        } else {
+          inside = rel.dot(normal) > std::cos(0.25 * std::numbers::pi) * std::sqrt(d2);  // the cone
+        }
+        if (inside) {
+          surface = false;
+          break;
+        }
+      }
+    }
+    if (surface) {
+      flags[iu] = 1;
+      normals[iu] = normal;
+    }
+  });
+  // Step 5: temporal coherence. A node not on the surface at the last step joins it only next to
+  // one that was, or when its support is plainly one-sided (lambda <= surface_below).
+  if (!previous.empty()) {
+    std::vector<std::uint8_t> keep(flags);
+    exec::particle_for(policy, n, [&](Index i) {
+      const auto iu = static_cast<std::size_t>(i);
+      if (flags[iu] == 0 || previous[iu] != 0 || lambda[iu] <= options.surface_below) return;
+      bool near_surface = false;
+      for (const Index j : relation.row(i)) near_surface = near_surface || previous[static_cast<std::size_t>(j)] != 0;
+      if (!near_surface) keep[iu] = 0;
+    });
+    for (Index i = 0; i < n; ++i) {
+      if (keep[static_cast<std::size_t>(i)] == 0) normals[static_cast<std::size_t>(i)].setZero();
+    }
+    flags.swap(keep);
+  }
+  // Step 4 (2D): the improved normal, from the perpendiculars to the chords to the surface
+  // neighbours, each turned to the first normal's side.
+  if constexpr (Dim == 2) {
+    std::vector<Vec<Dim>> improved(normals);
+    exec::particle_for(policy, n, [&](Index i) {
+      const auto iu = static_cast<std::size_t>(i);
+      if (flags[iu] == 0) return;
+      Vec<Dim> sum = Vec<Dim>::Zero();
+      for (const Index j : relation.row(i)) {
+        const auto ju = static_cast<std::size_t>(j);
+        if (j == i || flags[ju] == 0) continue;
+        const Vec<Dim> c = set.position[ju] - set.position[iu];
+        if (c.squaredNorm() >= r2) continue;
+        Vec<Dim> p(-c[1], c[0]);
+        if (p.dot(normals[iu]) < 0.0) p = -p;
+        sum += p;
+      }
+      if (sum.norm() > 0.0) improved[iu] = sum / sum.norm();
+    });
+    normals.swap(improved);
+  }
+}
+
+template <int Dim>
+void make_traction_free(const Vec<Dim>& n, double* s) {
+  if constexpr (Dim == 1) {
+    s[0] = 0.0;  // the normal stress of an end (the lateral ones are kept)
+  } else {
+    // sigma <- sigma - (sigma n) (x) n - n (x) (sigma n) + (n . sigma n) n (x) n
+    Mat<Dim> S;
+    for (int k = 0; k < Dim; ++k) {
+      for (int d = 0; d < Dim; ++d) S(k, d) = s[stress_slot<Dim>(k, d)];
+    }
+    const Vec<Dim> sn = S * n;
+    const double nsn = n.dot(sn);
+    const Mat<Dim> R = S - sn * n.transpose() - n * sn.transpose() + nsn * n * n.transpose();
+    for (int k = 0; k < Dim; ++k) {
+      for (int d = k; d < Dim; ++d) s[stress_slot<Dim>(k, d)] = R(k, d);
+    }
+  }
+}
+
+#define RKTSPH_INSTANTIATE(D)                                                                                 \
+  template void detect_free_surface<D>(const ParticleSet<D>&, const Relation<D>&, const CubicSplineKernel<D>&, \
+                                       const FreeSurfaceOptions&, const std::vector<std::uint8_t>&,          \
+                                       const std::vector<std::uint8_t>&, std::vector<std::uint8_t>&,         \
+                                       std::vector<Vec<D>>&, const exec::Threads&);                           \
+  template void make_traction_free<D>(const Vec<D>&, double*);
+RKTSPH_INSTANTIATE(1)
+RKTSPH_INSTANTIATE(2)
+RKTSPH_INSTANTIATE(3)
+#undef RKTSPH_INSTANTIATE
+
+}  // namespace rktsph

@@ -1,0 +1,46 @@
+#pragma once
+// Free-surface detection and normals on a particle set (method-notes §3.6), for the
+// large-deformation scheme V2:
+//   1. B_I = sum_J V_J (x_J - x_I) (x) grad_I W_IJ and its smallest eigenvalue lambda_I: a
+//      surface node if lambda_I <= surface_below, interior if > interior_above, else a candidate;
+//   2. the normal n_I = nu / |nu|, nu = -B_I^{-1} sum_J V_J grad_I W_IJ (outward);
+//   3. candidates: the umbrella scan of Marrone et al. about T = x_I + h n_I (2D: the square
+//      test within sqrt(2) h, 3D: a cone of half-angle pi/4), any neighbour inside it making the
+//      node interior;
+//   4. 2D: the improved normal, from the perpendiculars to the chords to the surface neighbours;
+//   5. temporal coherence: a node that was not on the surface may become one only next to a
+//      node that was, or with lambda_I <= surface_below (a genuinely new surface);
+//   6. nodes excluded by the caller (explicit boundary conditions) are never flagged.
+#include <cstdint>
+#include <vector>
+
+#include "core/execution.hpp"
+#include "core/kernel.hpp"
+#include "neighbours/relation.hpp"
+#include "particles/particle_set.hpp"
+
+namespace rktsph {
+
+struct FreeSurfaceOptions {
+  double surface_below = 0.2;    // lambda_min of B at or below which a node is on the surface
+  double interior_above = 0.75;  // lambda_min above which it is interior without the scan
+};
+
+/// Flags (1 = free surface) and outward unit normals of every particle of `set`, from
+/// `relation` (the set's own neighbours within the support; a wider Verlet list is cut back).
+/// `previous` (may be empty) holds the flags of the last step for the temporal coherence;
+/// `excluded` (may be empty) the particles never flagged. Normals are zero off the surface.
+template <int Dim>
+void detect_free_surface(const ParticleSet<Dim>& set, const Relation<Dim>& relation,
+                         const CubicSplineKernel<Dim>& kernel, const FreeSurfaceOptions& options,
+                         const std::vector<std::uint8_t>& previous, const std::vector<std::uint8_t>& excluded,
+                         std::vector<std::uint8_t>& flags, std::vector<Vec<Dim>>& normals,
+                         const exec::Threads& policy = {});
+
+/// Traction-free stress by rotation to the local frame (method-notes §3.7): sigma.n = 0 with the
+/// tangential stress kept, sigma <- sigma - (sigma n) (x) n - n (x) (sigma n) + (n.sigma n) n (x) n;
+/// the out-of-plane sigma_zz is kept in 2D.
+template <int Dim>
+void make_traction_free(const Vec<Dim>& n, double* stress);
+
+}  // namespace rktsph

@@ -1,0 +1,113 @@
+// Free-surface detection (operators/free_surface.hpp, method-notes §3.6) and the traction-free
+// rotation (§3.7): the flags of a square and of a disc, outward normals, and sigma.n = 0.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
+
+#include "operators/free_surface.hpp"
+#include "particles/lattice.hpp"
+
+namespace rktsph {
+namespace {
+
+struct Cloud {
+  ParticleSet<2> set{"nodes"};
+  std::set<std::pair<long, long>> cells;  // lattice coordinates of the particles
+};
+
+// Lattice points (i dx, j dx) where keep(x, y), with tributary-free unit volumes dx^2.
+template <class Keep>
+Cloud lattice_cloud(double dx, int n, Keep&& keep) {
+  Cloud c;
+  for (int j = -n; j <= n; ++j) {
+    for (int i = -n; i <= n; ++i) {
+      const Vec<2> x(i * dx, j * dx);
+      if (!keep(x)) continue;
+      c.set.add(x, dx * dx, 2000.0, 0);
+      c.cells.insert({i, j});
+    }
+  }
+  return c;
+}
+
+std::vector<std::uint8_t> flags_of(const Cloud& c, std::vector<Vec<2>>& normals, double dx) {
+  const CubicSplineKernel<2> kernel(1.2 * dx);
+  Relation<2> rel;
+  rel.build(c.set.position, c.set.position, {kernel.support_radius(), 1, true});
+  std::vector<std::uint8_t> flags;
+  detect_free_surface<2>(c.set, rel, kernel, {}, {}, {}, flags, normals);
+  return flags;
+}
+
+long count(const std::vector<std::uint8_t>& f) { return std::count(f.begin(), f.end(), std::uint8_t{1}); }
+
+TEST(FreeSurface, TheFlagsOfASquareAreItsFaceNodesExactly) {
+  const double dx = 0.1;
+  const Cloud c = lattice_cloud(dx, 10, [](const Vec<2>&) { return true; });
+  std::vector<Vec<2>> normals;
+  const auto flags = flags_of(c, normals, dx);
+  for (Index i = 0; i < c.set.size(); ++i) {
+    const auto& x = c.set.position[static_cast<std::size_t>(i)];
+    const bool face = std::abs(std::abs(x[0]) - 1.0) < 1e-9 || std::abs(std::abs(x[1]) - 1.0) < 1e-9;
+    EXPECT_EQ(flags[static_cast<std::size_t>(i)] != 0, face) << "node at " << x.transpose();
+    if (face && std::abs(x[1]) < 1.0 - 2.5 * dx) {
+      // A side node away from the corners (whose chords bend it): the face's normal, outward.
+      EXPECT_NEAR(normals[static_cast<std::size_t>(i)][0], x[0] > 0 ? 1.0 : -1.0, 1e-6) << x.transpose();
+    }
+  }
+  EXPECT_EQ(count(flags), 80);
+}
+
+TEST(FreeSurface, TheFlagsOfADiscAreItsOuterRingWithOutwardNormals) {
+  const double dx = 0.1, R = 1.0;
+  const Cloud c = lattice_cloud(dx, 12, [&](const Vec<2>& x) { return x.norm() <= R + 1e-9; });
+  std::vector<Vec<2>> normals;
+  const auto flags = flags_of(c, normals, dx);
+  long missing = 0, wrong = 0;
+  for (Index i = 0; i < c.set.size(); ++i) {
+    const auto& x = c.set.position[static_cast<std::size_t>(i)];
+    const long ix = std::lround(x[0] / dx), iy = std::lround(x[1] / dx);
+    auto has = [&](long a, long b) { return c.cells.count({ix + a, iy + b}) != 0; };
+    const bool edge = !has(1, 0) || !has(-1, 0) || !has(0, 1) || !has(0, -1);
+    const bool deep = x.norm() < R - 2.0 * dx;  // a full support of material around it
+    if (edge && flags[static_cast<std::size_t>(i)] == 0) ++missing;
+    if (deep && flags[static_cast<std::size_t>(i)] != 0) ++wrong;
+    if (flags[static_cast<std::size_t>(i)] != 0) {
+      EXPECT_GT(normals[static_cast<std::size_t>(i)].dot(x.normalized()), 0.9) << "normal at " << x.transpose();
+    }
+  }
+  EXPECT_EQ(missing, 0) << "edge nodes not flagged";
+  EXPECT_EQ(wrong, 0) << "interior nodes flagged";
+}
+
+TEST(FreeSurface, ExcludedNodesAreNeverFlagged) {
+  const double dx = 0.1;
+  const Cloud c = lattice_cloud(dx, 5, [](const Vec<2>&) { return true; });
+  const CubicSplineKernel<2> kernel(1.2 * dx);
+  Relation<2> rel;
+  rel.build(c.set.position, c.set.position, {kernel.support_radius() + 0.05, 2, true});  // a Verlet skin
+  std::vector<std::uint8_t> excluded(static_cast<std::size_t>(c.set.size()), 1), flags;
+  std::vector<Vec<2>> normals;
+  detect_free_surface<2>(c.set, rel, kernel, {}, {}, excluded, flags, normals);
+  EXPECT_EQ(count(flags), 0);
+}
+
+TEST(FreeSurface, TheTractionFreeRotationZeroesSigmaNAndKeepsTheTangentialStress) {
+  const double a = 0.6;
+  const Vec<2> n(std::cos(a), std::sin(a)), t(-std::sin(a), std::cos(a));
+  double s[4] = {-3.0e4, -1.0e4, -2.0e4, 5.0e3};  // xx, yy, zz, xy
+  auto tensor = [&] {
+    Mat<2> S;
+    S << s[0], s[3], s[3], s[1];
+    return S;
+  };
+  const double tt0 = t.dot(tensor() * t);
+  make_traction_free<2>(n, s);
+  EXPECT_LT((tensor() * n).norm(), 1e-10);
+  EXPECT_NEAR(t.dot(tensor() * t), tt0, 1e-9);
+  EXPECT_EQ(s[2], -2.0e4);  // sigma_zz kept
+}
+
+}  // namespace
+}  // namespace rktsph
