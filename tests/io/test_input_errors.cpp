@@ -273,5 +273,18 @@ TEST(InputErrors, SetOverrideWithWrongType) {
   }
 }
 
+// ---- numbers
+
+TEST(InputErrors, NumbersBeyondThePhysicalRange) {
+  test::TempDir dir;
+  for (const char* bad : {"E = 1.0e300", "E = -1.0e101"}) {
+    const std::string text = replace(kBase, "E = 1.0e7", bad);
+    const auto o = run_case_text(dir, text);
+    expect_error_at(o, line_of(text, bad), "material.E", {"1e+100"});
+  }
+  const std::string text = replace(kBase, "position = [2.0, 1.0]", "position = [2.0, 1e200]");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "position = "), "probe[0].position", {"1e+100"});
+}
 }  // namespace
 }  // namespace rktsph
