@@ -286,5 +286,105 @@ TEST(InputErrors, NumbersBeyondThePhysicalRange) {
   const auto o = run_case_text(dir, text);
   expect_error_at(o, line_of(text, "position = "), "probe[0].position", {"1e+100"});
 }
+
+// ---- --set
+
+TEST(InputErrors, SetWithTextAfterTheValue) {
+  test::TempDir dir;
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"time.end=1.0abc", "'1.0' is a value but 'abc' follows it"},
+      {"solver.version=\"v1\"x", "'\"v1\"' is a value but 'x' follows it"},
+      {"geometry.origin=[0.0, 0.0]x", "'[0.0, 0.0]' is a value but 'x' follows it"},
+      {"time.end=0.001 # a comment", "text after the value: '# a comment'"},
+      {"time.end=0.001\nmaterial.E=1", "text after the value: 'material.E=1'"},
+      {"time.end=", "no value after '='"},
+      {"geometry.origin=[0.0, 0.0", "is not a valid TOML value"},
+      {"title=\"unclosed", "is not a valid TOML value"},
+  };
+  for (const auto& [set, why] : bad) {
+    const auto o = run_case_text(dir, kBase, {set});
+    expect_input_error(o, "", {"--set '", why});
+  }
+  // A bare word is still a string, and blanks around a value are fine.
+  for (const char* good : {"solver.version=v1", "title=a bare title", "time.end= 0.001 "}) {
+    const auto o = run_case_text(dir, kBase, {good});
+    EXPECT_EQ(o.status, 0) << good << ": " << o.err;
+  }
+}
+
+TEST(InputErrors, SetKeyPaths) {
+  test::TempDir dir;
+  {
+    const auto o = run_case_text(dir, kBase, {"time.end.x=1.0"});
+    expect_input_error(
+        o, "", {"--set '", fmt::format("'time.end' is a value (line {}), not a table", line_of(kBase, "end = "))});
+  }
+  {
+    // std::stoul read "0x" as 0.
+    const auto o = run_case_text(dir, kBase, {"boundary.0x.name=a"});
+    expect_input_error(o, "", {"--set '", "'0x' indexes an array and must be a whole number"});
+  }
+  {
+    const auto o = run_case_text(dir, kBase, {"boundary.3.name=a"});
+    expect_input_error(o, "", {"--set '", "index 3 is past the end of the array (1 entries)"});
+  }
+  for (const char* bad : {"time..end=1.0", ".time.end=1.0", "time.end.=1.0", "time. end=1.0"}) {
+    const auto o = run_case_text(dir, kBase, {bad});
+    expect_input_error(o, "", {"--set '", "empty or blank-padded part"});
+  }
+}
+
+// ---- material-point inputs (case/material_point_reader.cpp)
+
+constexpr const char* kMaterialPoint = R"([material]
+model = "perzyna_von_mises"
+E = 1.0e7
+nu = 0.3
+density = 2000.0
+cohesion = 5.0e4
+fluidity = 1.0
+
+[initial]
+stress = { xx = -1.0e5, yy = -1.0e5, zz = -1.0e5 }
+
+[path]
+type = "simple_shear"
+shear_strain_rate = 0.01
+duration = 1.0
+dt = 0.01
+
+[output]
+plot = false
+)";
+
+Outcome run_material_point_text(const test::TempDir& dir, const std::string& text,
+                                const std::vector<std::string>& sets = {}) {
+  const std::string file = dir.write("bad_point.toml", text);
+  std::string cmd = fmt::format("\"{}\" material-point \"{}\" --out \"{}\"", RKTSPH_BINARY, file, dir.file("out"));
+  for (const auto& s : sets) cmd += fmt::format(" --set '{}'", s);
+  cmd += " 2>&1 1>/dev/null";
+  const auto r = test::run_command(cmd);
+  return {r.status, r.out, file};
+}
+
+TEST(InputErrors, MaterialPointBaseRuns) {
+  test::TempDir dir;
+  const auto o = run_material_point_text(dir, kMaterialPoint);
+  EXPECT_EQ(o.status, 0) << o.err;
+}
+
+TEST(InputErrors, MaterialPointSetIsCheckedLikeRun) {
+  test::TempDir dir;
+  {
+    const auto o = run_material_point_text(dir, kMaterialPoint, {"material.E=1.0e7abc"});
+    expect_input_error(o, "", {"--set '", "'1.0e7' is a value but 'abc' follows it"});
+  }
+  {
+    // Array-of-tables entries and plain keys work as with run.
+    const auto o = run_material_point_text(dir, kMaterialPoint, {"material.E=2.0e7", "path.duration=0.5"});
+    EXPECT_EQ(o.status, 0) << o.err;
+  }
+}
+
 }  // namespace
 }  // namespace rktsph
