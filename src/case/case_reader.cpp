@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -10,6 +11,7 @@
 
 #include "case/case_reader.hpp"
 #include "case/material_reader.hpp"
+#include "case/size_limits.hpp"
 #include "core/error.hpp"
 #include "io/section.hpp"
 #include "materials/uniaxial_stress.hpp"
@@ -105,9 +107,9 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     ms.finish();
   }
 
-  // ---- geometry
+  // ---- geometry (the section is kept: the memory estimate below names its spacing)
+  const io::Section g = root.table("geometry");
   {
-    const io::Section g = root.table("geometry");
     g.integer("dimension");
     c.dx = g.positive("spacing");
     if (g.has("condition")) {
@@ -139,6 +141,12 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
       c.blocks.push_back(blk);
     }
     g.finish();
+    // Size guard: lattice coordinates within the lattice's integer range (case/size_limits.hpp),
+    // before the lattice generator converts them.
+    if (auto p = lattice_size_problem(c)) {
+      if (p->block >= 0) blocks[static_cast<std::size_t>(p->block)].fail(p->key, p->message);
+      g.fail(p->key, p->message);
+    }
   }
   if (Dim == 1 && c.condition == BarCondition::uniaxial_stress) {
     // docs/cases.md Case 2: scalar sigma with zero lateral stresses; the wrapper gives the
@@ -283,31 +291,6 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     iv->finish();
   }
 
-  // ---- time
-  {
-    const io::Section t = root.table("time");
-    c.end_time = t.positive("end");
-    const bool has_cfl = t.has("cfl"), has_dt = t.has("dt");
-    if (has_cfl && has_dt) t.fail("dt", "give either cfl or dt, not both");
-    if (has_dt) {
-      c.dt = t.positive("dt");
-      t.number("cfl", 0.0);
-    } else {
-      c.cfl = t.positive("cfl", 0.5);
-      t.number("dt", 0.0);
-    }
-    // method-notes §0.3 item 4: reject C > kMaxCourant here, where the key's line is known (the
-    // schemes check again for setups built in code, without a line).
-    const TimeStep step = time_step_from(c.dx, max_wave_speed(c.materials), c.cfl, c.dt);
-    if (step.courant > kMaxCourant) {
-      t.fail(has_dt ? "dt" : "cfl",
-             fmt::format("the Courant number c dt/dx = {:.3f} exceeds {} (c = {:.4g} m/s, dx = {} "
-                         "m); the scheme is unstable beyond it (method-notes §0.3 item 4)",
-                         step.courant, kMaxCourant, step.wave_speed, c.dx));
-    }
-    t.finish();
-  }
-
   // ---- solver
   if (auto s = root.optional_table("solver")) {
     c.version = s->string("version", "v1");
@@ -400,6 +383,47 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     if (!saturated && (b.pore_pressure || b.impermeable)) {
       throw InputError(fmt::format("{}: pore_pressure / impermeable need solver.version = \"v3\"", b.where));
     }
+  }
+
+  // ---- size guard: particles and an estimate of the memory, from the blocks, before any
+  // particle exists (case/size_limits.hpp; StaggeredModel checks again with the exact counts).
+  {
+    const SizeEstimate e = estimate_size(c, saturated);
+    if (auto p = memory_problem(c, saturated, e.nodes, e.stress_points, e.lattice_cells)) g.fail(p->key, p->message);
+  }
+
+  // ---- time
+  {
+    const io::Section t = root.table("time");
+    c.end_time = t.positive("end");
+    const bool has_cfl = t.has("cfl"), has_dt = t.has("dt");
+    if (has_cfl && has_dt) t.fail("dt", "give either cfl or dt, not both");
+    if (has_dt) {
+      c.dt = t.positive("dt");
+      t.number("cfl", 0.0);
+    } else {
+      c.cfl = t.positive("cfl", 0.5);
+      t.number("dt", 0.0);
+    }
+    // method-notes §0.3 item 4: reject C > kMaxCourant here, where the key's line is known (the
+    // schemes check again for setups built in code, without a line).
+    const TimeStep step = time_step_from(c.dx, max_wave_speed(c.materials), c.cfl, c.dt);
+    if (step.courant > kMaxCourant) {
+      t.fail(has_dt ? "dt" : "cfl",
+             fmt::format("the Courant number c dt/dx = {:.3f} exceeds {} (c = {:.4g} m/s, dx = {} "
+                         "m); the scheme is unstable beyond it (method-notes §0.3 item 4)",
+                         step.courant, kMaxCourant, step.wave_speed, c.dx));
+    }
+    // Size guard: the number of steps, before the run (case/size_limits.hpp).
+    c.max_steps = t.number("max_steps", kDefaultMaxSteps);
+    t.require(c.max_steps >= 1.0 && c.max_steps <= kMaxStepsCeiling, "max_steps",
+              fmt::format("must lie in [1, {:.0e}] steps, got {}", kMaxStepsCeiling, c.max_steps));
+    const std::string dt_text =
+        has_dt ? std::string("time.dt")
+               : fmt::format("C = {} times dx = {} m over c = {:.4g} m/s, the fastest wave speed of the materials",
+                             *c.cfl, c.dx, step.wave_speed);
+    if (auto p = step_count_problem(c.end_time, step.dt, c.max_steps, dt_text)) t.fail(p->key, p->message);
+    t.finish();
   }
 
   // ---- output and probes

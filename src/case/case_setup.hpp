@@ -14,6 +14,9 @@
 
 namespace rktsph {
 
+/// Default of time.max_steps: a run of more steps must say so in its case file.
+inline constexpr double kDefaultMaxSteps = 1.0e8;
+
 /// Nodes selected by an axis-aligned box; an axis left open selects everything along it.
 template <int Dim>
 struct Region {
@@ -150,6 +153,9 @@ struct CaseSetup {
   double end_time = 0.0;
   std::optional<double> cfl;
   std::optional<double> dt;
+  /// time.max_steps: the run is refused before it starts if end_time / dt exceeds it
+  /// (case/size_limits.hpp).
+  double max_steps = kDefaultMaxSteps;
 
   // solver
   /// The scheme, by its registry name (solver.version): "v1" dry, "v3" saturated (the v-p_w

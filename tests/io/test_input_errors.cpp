@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "../support/test_util.hpp"
+#include "case/size_limits.hpp"
 
 namespace rktsph {
 namespace {
@@ -273,7 +274,94 @@ TEST(InputErrors, SetOverrideWithWrongType) {
   }
 }
 
+// ---- size guards (case/size_limits.hpp, docs/case-format.md "Size limits")
+
+TEST(InputErrors, StepCountBeyondMaxSteps) {
+  test::TempDir dir;
+  {
+    // Used to overflow the step count: 0 steps, "completed".
+    const auto o = run_case_text(dir, kBase, {"time.end=1e30"});
+    expect_input_error(o, "time.end", {"command line", "steps", "time.max_steps", "1e+15"});
+  }
+  {
+    // A light material: c = 4e13 m/s, 1.5e11 steps (used to run until killed).
+    const auto o = run_case_text(dir, kBase, {"material.density=1e-20"});
+    expect_error_at(o, line_of(kBase, "end = "), "time.end", {"steps", "c = ", "time.max_steps"});
+  }
+}
+
+TEST(InputErrors, MaxStepsAllowsALongerRun) {
+  test::TempDir dir;
+  // dt = 0.5 * 0.5 m / 82.04 m/s = 3.047e-3 s: 0.05 s is 16.4 steps.
+  {
+    const auto o = run_case_text(dir, kBase, {"time.end=0.05", "time.max_steps=10"});
+    expect_input_error(o, "time.end", {"16.4", "time.max_steps (>= 17)"});
+  }
+  {
+    const auto o = run_case_text(dir, kBase, {"time.end=0.05", "time.max_steps=17"});
+    EXPECT_EQ(o.status, 0) << o.err;
+  }
+  for (const char* bad : {"time.max_steps=0", "time.max_steps=1e16", "time.max_steps=-5"}) {
+    const auto o = run_case_text(dir, kBase, {bad});
+    expect_input_error(o, "time.max_steps", {"[1, 1e+15]"});
+  }
+}
+
+TEST(InputErrors, TinySpacingNamesTheSpacing) {
+  test::TempDir dir;
+  // Used to overflow the lattice's int coordinates and report a misaligned block.
+  const std::string text = replace(kBase, "spacing = 0.5", "spacing = 1.0e-12");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "spacing"), "geometry.spacing", {"geometry.block[0]", "cells per axis"});
+}
+
+TEST(InputErrors, BlockFarFromTheOrigin) {
+  test::TempDir dir;
+  const auto o = run_case_text(dir, kBase, {"geometry.origin=[1.0e12, 0.0]"});
+  expect_error_at(o, line_of(kBase, "min = "), "geometry.block[0].min", {"spacings", "geometry.origin"});
+}
+
+TEST(InputErrors, BlocksSpanningTooManyCells) {
+  test::TempDir dir;
+  // Each block is small and near enough to the origin, but together they span 6e8 cells.
+  const std::string text = replace(replace(kBase, "spacing = 0.5", "spacing = 1.0"), "[material]",
+                                   "[[geometry.block]]\nmin = [-3.0e8, 0.0]\nmax = [-2.99999998e8, 1.0]\n\n"
+                                   "[[geometry.block]]\nmin = [3.0e8, 0.0]\nmax = [3.00000002e8, 1.0]\n\n[material]");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "spacing"), "geometry.spacing", {"blocks together span 6e+08 cells", "per axis"});
+}
+
+TEST(InputErrors, TooManyParticles) {
+  test::TempDir dir;
+  // 2e5 x 1e5 cells: 2e10 particles, more than a 32-bit index.
+  const std::string text = replace(kBase, "spacing = 0.5", "spacing = 1.0e-5");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "spacing"), "geometry.spacing", {"2147483647 particles"});
+}
+
+TEST(InputErrors, MemoryEstimateAboveThePhysicalMemory) {
+  test::TempDir dir;
+  // 4e4 x 2e4 cells: 8e8 nodes, about 520 GiB at 700 bytes per node (a dry 2D case).
+  const double need = 8.0e8 * bytes_per_node(2, false);
+  if (physical_memory_bytes() >= need) GTEST_SKIP() << "this machine has more than " << need << " bytes";
+  const std::string text = replace(kBase, "spacing = 0.5", "spacing = 5.0e-5");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "spacing"), "geometry.spacing",
+                  {"8e+08 nodes", "GiB", "bytes per node", "memory", "larger spacing"});
+}
+
 // ---- numbers
+
+TEST(InputErrors, IntegerBeyondADoubleIsANumber) {
+  test::TempDir dir;
+  // An integer a double does not hold exactly used to be "not a number" (and, in an array, an
+  // uncaught std::bad_optional_access, exit 1).
+  const std::string text = replace(kBase, "min = [0.0, 0.0]", "min = [9223372036854775807, 0.0]");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "min = "), "geometry.block[0].min", {"spacings"});
+  const auto e = run_case_text(dir, replace(kBase, "E = 1.0e7", "E = 9223372036854775807"), {"time.max_steps=10"});
+  expect_input_error(e, "time.end", {"steps"});
+}
 
 TEST(InputErrors, NumbersBeyondThePhysicalRange) {
   test::TempDir dir;
