@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <iostream>
 #include <limits>
 #include <sstream>
 
@@ -309,8 +310,10 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
               fmt::format("unknown preconditioner '{}' (known: jacobi, incomplete_cholesky)", pc));
     c.fluid.tolerance = s->positive("pressure_tolerance", 1e-8);
     s->require(c.fluid.tolerance < 1e-2, "pressure_tolerance", "must be < 1e-2");
-    c.fluid.max_iterations = static_cast<int>(s->integer("pressure_max_iterations", 2000));
-    s->require(c.fluid.max_iterations >= 1, "pressure_max_iterations", "must be >= 1");
+    const std::int64_t max_iterations = s->integer("pressure_max_iterations", 2000);
+    s->require(max_iterations >= 1 && max_iterations <= std::numeric_limits<int>::max(), "pressure_max_iterations",
+               fmt::format("must lie in [1, {}], got {}", std::numeric_limits<int>::max(), max_iterations));
+    c.fluid.max_iterations = static_cast<int>(max_iterations);
     c.fluid.deferred_correction = s->boolean("pressure_deferred_correction", true);
     const std::string divergence = s->string("pressure_divergence", "nodes");
     if (divergence == "nodes")
@@ -429,20 +432,57 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
   // ---- output and probes
   if (auto o = root.optional_table("output")) {
     c.output_interval = o->non_negative("interval", 0.0);
+    // The run advances the next frame time by the interval until it passes the clock: an
+    // interval far below the step would take that loop end / interval rounds (and stall once
+    // the interval is below the clock's rounding), so it is bounded like the step count.
+    o->require(c.output_interval == 0.0 || c.end_time / c.output_interval <= c.max_steps, "interval",
+               fmt::format("{} s gives {:.3g} frame times over time.end = {} s, more than time.max_steps = {:.4g}; "
+                           "use 0 (first and last frames), or at least the time step for a frame every step",
+                           c.output_interval, c.end_time / c.output_interval, c.end_time, c.max_steps));
     if (o->has("times")) {
       c.output_times = o->numbers("times");
       std::sort(c.output_times.begin(), c.output_times.end());
+      if (!c.output_times.empty()) {
+        o->require(c.output_times.front() >= 0.0, "times",
+                   fmt::format("snapshot times must be >= 0 s, got {}", c.output_times.front()));
+      }
+      // Snapshot times past the end cannot be written. A warning, not an error: shortening a run
+      // with --set time.end=... is the usual quick look at a case, and must not need its
+      // snapshot list edited too.
+      std::vector<double> late;
+      for (const double t : c.output_times) {
+        if (t > c.end_time) late.push_back(t);
+      }
+      if (!late.empty()) {
+        c.warnings.push_back(fmt::format(
+            "{}: {} of the snapshot times ({} s) {} past time.end = {} s and will not be "
+            "written",
+            o->where("times"), late.size(), fmt::join(late, ", "), late.size() == 1 ? "is" : "are", c.end_time));
+      }
     } else {
       o->number("times", 0.0);
     }
     c.output_elements = o->boolean("elements", true);
-    c.probe_every = static_cast<int>(o->integer("probe_every", 1));
-    o->require(c.probe_every >= 1, "probe_every", "must be >= 1");
+    const std::int64_t every = o->integer("probe_every", 1);
+    o->require(every >= 1 && every <= std::numeric_limits<int>::max(), "probe_every",
+               fmt::format("must lie in [1, {}], got {}", std::numeric_limits<int>::max(), every));
+    c.probe_every = static_cast<int>(every);
     o->finish();
   }
   for (const io::Section& p : root.tables("probe")) {
     ProbeSpec spec;
     spec.name = p.string("name");
+    // The name heads columns of probes.csv ("name.field"): nothing that breaks a CSV header.
+    p.require(!spec.name.empty(), "name", "must not be empty (it heads the probe's columns in probes.csv)");
+    for (const char ch : spec.name) {
+      const auto u = static_cast<unsigned char>(ch);
+      if (ch == ',' || ch == '"' || u < 0x20 || u == 0x7f) {
+        p.fail("name", fmt::format("must not contain {} (the name heads the probe's columns in probes.csv)",
+                                   ch == ','   ? std::string("a comma")
+                                   : ch == '"' ? std::string("a double quote")
+                                               : fmt::format("a control character (code {})", static_cast<int>(u))));
+      }
+    }
     spec.where = p.where("position");
     spec.position = p.numbers("position");
     if (static_cast<int>(spec.position.size()) != Dim) {
@@ -457,6 +497,7 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     c.probes.push_back(std::move(spec));
   }
   root.finish();
+  for (const std::string& w : c.warnings) std::cerr << "warning: " << w << "\n";
   return c;
 }
 

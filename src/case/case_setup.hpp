@@ -174,6 +174,10 @@ struct CaseSetup {
   int probe_every = 1;
   std::vector<ProbeSpec> probes;
 
+  /// Warnings of the reader (also written to stderr when the case is read), e.g. snapshot
+  /// times past the end.
+  std::vector<std::string> warnings;
+
   std::vector<std::string> function_names;
   std::vector<TimeFunction> functions;
   double function_value(int index, double t) const {

@@ -375,6 +375,75 @@ TEST(InputErrors, NumbersBeyondThePhysicalRange) {
   expect_error_at(o, line_of(text, "position = "), "probe[0].position", {"1e+100"});
 }
 
+TEST(InputErrors, IntegersBeyondTheirRange) {
+  test::TempDir dir;
+  {
+    // 2^32 + 1 used to wrap to 1.
+    const std::string text = replace(kBase, "[[probe]]", "[output]\nprobe_every = 4294967297\n\n[[probe]]");
+    const auto o = run_case_text(dir, text);
+    expect_error_at(o, line_of(text, "probe_every"), "output.probe_every", {"2147483647"});
+  }
+  {
+    const std::string text =
+        replace(kBase, "[time]", "[solver]\npressure_max_iterations = 9223372036854775807\n[time]");
+    const auto o = run_case_text(dir, text);
+    expect_error_at(o, line_of(text, "pressure_max_iterations"), "solver.pressure_max_iterations", {"2147483647"});
+  }
+}
+
+// ---- output
+
+TEST(InputErrors, OutputIntervalFarBelowTheStep) {
+  test::TempDir dir;
+  // The frame clock would need 1e297 rounds (and stall below the clock's rounding): a hang.
+  const std::string text = replace(kBase, "[[probe]]", "[output]\ninterval = 1.0e-300\n\n[[probe]]");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "interval"), "output.interval", {"time.max_steps", "time step"});
+}
+
+TEST(InputErrors, SnapshotTimesPastTheEndWarn) {
+  test::TempDir dir;
+  const std::string text = replace(kBase, "[[probe]]", "[output]\ntimes = [0.0005, 5.0, 2.0]\n\n[[probe]]");
+  const std::string file = dir.write("late.toml", text);
+  const auto r = test::run_command(
+      fmt::format("\"{}\" run \"{}\" --out \"{}\" -q 2>&1 1>/dev/null", RKTSPH_BINARY, file, dir.file("out")));
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("warning: "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(file), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(fmt::format("line {}, key 'output.times'", line_of(text, "times = "))), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("2 of the snapshot times (2, 5 s) are past time.end = 0.001 s"), std::string::npos) << r.out;
+  // The reader keeps the warning for callers that print their own.
+  const auto setup = test::case_from_string<2>(dir, text);
+  ASSERT_EQ(setup.warnings.size(), 1u);
+}
+
+TEST(InputErrors, NegativeSnapshotTime) {
+  test::TempDir dir;
+  const std::string text = replace(kBase, "[[probe]]", "[output]\ntimes = [0.0005, -1.0]\n\n[[probe]]");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "times = "), "output.times", {">= 0"});
+}
+
+TEST(InputErrors, ProbeNamesThatBreakTheCsvHeader) {
+  test::TempDir dir;
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {R"(name = "a,b")", "a comma"},
+      {R"(name = "a\"b")", "a double quote"},
+      {R"(name = "a\nb")", "a control character (code 10)"},
+      {R"(name = "a\tb")", "a control character (code 9)"},
+      {R"(name = "")", "must not be empty"},
+  };
+  for (const auto& [line, why] : bad) {
+    const std::string text = replace(kBase, "name = \"corner\"", line);
+    const auto o = run_case_text(dir, text);
+    expect_error_at(o, line_of(text, line), "probe[0].name", {why, "probes.csv"});
+  }
+  // Dots, blanks and other printable characters are fine.
+  const auto o = run_case_text(dir, replace(kBase, "name = \"corner\"", "name = \"top corner (x=2).v\""));
+  EXPECT_EQ(o.status, 0) << o.err;
+}
+
 // ---- --set
 
 TEST(InputErrors, SetWithTextAfterTheValue) {
