@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <limits>
 
 #include <fmt/format.h>
 #include <toml++/toml.h>
@@ -70,9 +71,20 @@ LoadPath read_path(const io::Section& s, std::string& type, std::string& plot_st
   }
   path.duration = s.positive("duration");
   path.dt = s.positive("dt", path.duration / 1000.0);
+  // Size guards: the steps of the path and the rows kept in memory and written to path.csv.
+  const double steps = std::ceil(path.duration / path.dt);
+  s.require(steps <= kDefaultMaxSteps, "dt",
+            fmt::format("duration / dt = {} s / {} s = {:.4g} steps, more than {:.0e}: use a larger dt", path.duration,
+                        path.dt, steps, kDefaultMaxSteps));
   const std::int64_t every = s.integer("output_every", 1);
-  s.require(every >= 1, "output_every", fmt::format("must be >= 1, got {}", every));
+  s.require(every >= 1 && every <= std::numeric_limits<int>::max(), "output_every",
+            fmt::format("must lie in [1, {}], got {}", std::numeric_limits<int>::max(), every));
   path.output_every = static_cast<int>(every);
+  constexpr double kMaxRows = 1.0e7;
+  s.require(steps / static_cast<double>(every) <= kMaxRows, "output_every",
+            fmt::format("{} steps with a row every {} make {:.4g} rows of path.csv, more than {:.0e}: raise "
+                        "output_every",
+                        steps, every, steps / static_cast<double>(every), kMaxRows));
   s.finish();
   return path;
 }

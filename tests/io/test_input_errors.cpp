@@ -530,6 +530,27 @@ TEST(InputErrors, MaterialPointBaseRuns) {
   EXPECT_EQ(o.status, 0) << o.err;
 }
 
+TEST(InputErrors, MaterialPointStepsAndRows) {
+  test::TempDir dir;
+  {
+    // 1e300 steps used to run until killed.
+    const std::string text = replace(kMaterialPoint, "dt = 0.01", "dt = 1.0e-300");
+    const auto o = run_material_point_text(dir, text);
+    expect_error_at(o, line_of(text, "dt = "), "path.dt", {"steps", "larger dt"});
+  }
+  {
+    // 5e7 steps, each a row: 5e7 rows held in memory and written.
+    const std::string text = replace(kMaterialPoint, "dt = 0.01", "dt = 2.0e-8");
+    const auto o = run_material_point_text(dir, text);
+    expect_input_error(o, "path.output_every", {"rows of path.csv", "raise output_every"});
+  }
+  {
+    const std::string text = replace(kMaterialPoint, "dt = 0.01", "dt = 0.01\noutput_every = 4294967297");
+    const auto o = run_material_point_text(dir, text);
+    expect_error_at(o, line_of(text, "output_every"), "path.output_every", {"2147483647"});
+  }
+}
+
 TEST(InputErrors, MaterialPointSetIsCheckedLikeRun) {
   test::TempDir dir;
   {
