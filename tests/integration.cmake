@@ -13,3 +13,14 @@ foreach(case_id IN LISTS RKTSPH_VALIDATION_CASES)
                    --out ${CMAKE_BINARY_DIR}/validation/quick_${case_id})
   set_tests_properties(validate_quick_${case_id} PROPERTIES LABELS validation TIMEOUT 1500)
 endforeach()
+
+# Fuzz test of the input reading (scripts/fuzz_inputs.py): 4000 mutated thesis-case and
+# material-point files through the binary, each a few steps long; every outcome must be exit 0,
+# 2 with the file and a line or key named, or 3 with a solver diagnosis; never a crash, a hang or
+# an uncaught error. A fixed seed: a failure prints the input's number and how to rerun it.
+# About 27 s with its two jobs on a 2-core machine; PROCESSORS 2 keeps ctest -j 2 from running
+# another test beside it.
+add_test(NAME fuzz_inputs
+         COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/scripts/fuzz_inputs.py --binary $<TARGET_FILE:rktsph>
+                 --count 4000 --seed 14 --jobs 2 --timeout 120 --work ${CMAKE_BINARY_DIR}/test-out/fuzz)
+set_tests_properties(fuzz_inputs PROPERTIES LABELS fuzz PROCESSORS 2 TIMEOUT 900)

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <iostream>
+#include <limits>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -10,6 +12,7 @@
 
 #include "case/case_reader.hpp"
 #include "case/material_reader.hpp"
+#include "case/size_limits.hpp"
 #include "core/error.hpp"
 #include "io/section.hpp"
 #include "materials/uniaxial_stress.hpp"
@@ -105,9 +108,9 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     ms.finish();
   }
 
-  // ---- geometry
+  // ---- geometry (the section is kept: the memory estimate below names its spacing)
+  const io::Section g = root.table("geometry");
   {
-    const io::Section g = root.table("geometry");
     g.integer("dimension");
     c.dx = g.positive("spacing");
     if (g.has("condition")) {
@@ -139,6 +142,12 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
       c.blocks.push_back(blk);
     }
     g.finish();
+    // Size guard: lattice coordinates within the lattice's integer range (case/size_limits.hpp),
+    // before the lattice generator converts them.
+    if (auto p = lattice_size_problem(c)) {
+      if (p->block >= 0) blocks[static_cast<std::size_t>(p->block)].fail(p->key, p->message);
+      g.fail(p->key, p->message);
+    }
   }
   if (Dim == 1 && c.condition == BarCondition::uniaxial_stress) {
     // docs/cases.md Case 2: scalar sigma with zero lateral stresses; the wrapper gives the
@@ -293,31 +302,6 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     iv->finish();
   }
 
-  // ---- time
-  {
-    const io::Section t = root.table("time");
-    c.end_time = t.positive("end");
-    const bool has_cfl = t.has("cfl"), has_dt = t.has("dt");
-    if (has_cfl && has_dt) t.fail("dt", "give either cfl or dt, not both");
-    if (has_dt) {
-      c.dt = t.positive("dt");
-      t.number("cfl", 0.0);
-    } else {
-      c.cfl = t.positive("cfl", 0.5);
-      t.number("dt", 0.0);
-    }
-    // method-notes §0.3 item 4: reject C > kMaxCourant here, where the key's line is known (the
-    // schemes check again for setups built in code, without a line).
-    const TimeStep step = time_step_from(c.dx, max_wave_speed(c.materials), c.cfl, c.dt);
-    if (step.courant > kMaxCourant) {
-      t.fail(has_dt ? "dt" : "cfl",
-             fmt::format("the Courant number c dt/dx = {:.3f} exceeds {} (c = {:.4g} m/s, dx = {} "
-                         "m); the scheme is unstable beyond it (method-notes §0.3 item 4)",
-                         step.courant, kMaxCourant, step.wave_speed, c.dx));
-    }
-    t.finish();
-  }
-
   // ---- solver
   if (auto s = root.optional_table("solver")) {
     c.version = s->string("version", "v1");
@@ -336,8 +320,10 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
               fmt::format("unknown preconditioner '{}' (known: jacobi, incomplete_cholesky)", pc));
     c.fluid.tolerance = s->positive("pressure_tolerance", 1e-8);
     s->require(c.fluid.tolerance < 1e-2, "pressure_tolerance", "must be < 1e-2");
-    c.fluid.max_iterations = static_cast<int>(s->integer("pressure_max_iterations", 2000));
-    s->require(c.fluid.max_iterations >= 1, "pressure_max_iterations", "must be >= 1");
+    const std::int64_t max_iterations = s->integer("pressure_max_iterations", 2000);
+    s->require(max_iterations >= 1 && max_iterations <= std::numeric_limits<int>::max(), "pressure_max_iterations",
+               fmt::format("must lie in [1, {}], got {}", std::numeric_limits<int>::max(), max_iterations));
+    c.fluid.max_iterations = static_cast<int>(max_iterations);
     c.fluid.deferred_correction = s->boolean("pressure_deferred_correction", true);
     const std::string divergence = s->string("pressure_divergence", "nodes");
     if (divergence == "nodes")
@@ -416,25 +402,103 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     }
   }
 
+  // ---- size guard: particles and an estimate of the memory, from the blocks, before any
+  // particle exists (case/size_limits.hpp; StaggeredModel checks again with the exact counts).
+  {
+    const SizeEstimate e = estimate_size(c, saturated);
+    if (auto p = memory_problem(c, saturated, e.nodes, e.stress_points, e.lattice_cells)) g.fail(p->key, p->message);
+  }
+
+  // ---- time
+  {
+    const io::Section t = root.table("time");
+    c.end_time = t.positive("end");
+    const bool has_cfl = t.has("cfl"), has_dt = t.has("dt");
+    if (has_cfl && has_dt) t.fail("dt", "give either cfl or dt, not both");
+    if (has_dt) {
+      c.dt = t.positive("dt");
+      t.number("cfl", 0.0);
+    } else {
+      c.cfl = t.positive("cfl", 0.5);
+      t.number("dt", 0.0);
+    }
+    // method-notes §0.3 item 4: reject C > kMaxCourant here, where the key's line is known (the
+    // schemes check again for setups built in code, without a line).
+    const TimeStep step = time_step_from(c.dx, max_wave_speed(c.materials), c.cfl, c.dt);
+    if (step.courant > kMaxCourant) {
+      t.fail(has_dt ? "dt" : "cfl",
+             fmt::format("the Courant number c dt/dx = {:.3f} exceeds {} (c = {:.4g} m/s, dx = {} "
+                         "m); the scheme is unstable beyond it (method-notes §0.3 item 4)",
+                         step.courant, kMaxCourant, step.wave_speed, c.dx));
+    }
+    // Size guard: the number of steps, before the run (case/size_limits.hpp).
+    c.max_steps = t.number("max_steps", kDefaultMaxSteps);
+    t.require(c.max_steps >= 1.0 && c.max_steps <= kMaxStepsCeiling, "max_steps",
+              fmt::format("must lie in [1, {:.0e}] steps, got {}", kMaxStepsCeiling, c.max_steps));
+    const std::string dt_text =
+        has_dt ? std::string("time.dt")
+               : fmt::format("C = {} times dx = {} m over c = {:.4g} m/s, the fastest wave speed of the materials",
+                             *c.cfl, c.dx, step.wave_speed);
+    if (auto p = step_count_problem(c.end_time, step.dt, c.max_steps, dt_text)) t.fail(p->key, p->message);
+    t.finish();
+  }
+
   // ---- output and probes
   if (auto o = root.optional_table("output")) {
     c.output_interval = o->non_negative("interval", 0.0);
+    // The run advances the next frame time by the interval until it passes the clock: an
+    // interval far below the step would take that loop end / interval rounds (and stall once
+    // the interval is below the clock's rounding), so it is bounded like the step count.
+    o->require(c.output_interval == 0.0 || c.end_time / c.output_interval <= c.max_steps, "interval",
+               fmt::format("{} s gives {:.3g} frame times over time.end = {} s, more than time.max_steps = {:.4g}; "
+                           "use 0 (first and last frames), or at least the time step for a frame every step",
+                           c.output_interval, c.end_time / c.output_interval, c.end_time, c.max_steps));
     if (o->has("times")) {
       c.output_times = o->numbers("times");
       std::sort(c.output_times.begin(), c.output_times.end());
+      if (!c.output_times.empty()) {
+        o->require(c.output_times.front() >= 0.0, "times",
+                   fmt::format("snapshot times must be >= 0 s, got {}", c.output_times.front()));
+      }
+      // Snapshot times past the end cannot be written. A warning, not an error: shortening a run
+      // with --set time.end=... is the usual quick look at a case, and must not need its
+      // snapshot list edited too.
+      std::vector<double> late;
+      for (const double t : c.output_times) {
+        if (t > c.end_time) late.push_back(t);
+      }
+      if (!late.empty()) {
+        c.warnings.push_back(fmt::format(
+            "{}: {} of the snapshot times ({} s) {} past time.end = {} s and will not be "
+            "written",
+            o->where("times"), late.size(), fmt::join(late, ", "), late.size() == 1 ? "is" : "are", c.end_time));
+      }
     } else {
       o->number("times", 0.0);
     }
     c.output_elements = o->boolean("elements", true);
     if (o->has("checkpoint_interval")) c.checkpoint_interval = o->non_negative("checkpoint_interval", 0.0);
     else o->number("checkpoint_interval", 0.0);
-    c.probe_every = static_cast<int>(o->integer("probe_every", 1));
-    o->require(c.probe_every >= 1, "probe_every", "must be >= 1");
+    const std::int64_t every = o->integer("probe_every", 1);
+    o->require(every >= 1 && every <= std::numeric_limits<int>::max(), "probe_every",
+               fmt::format("must lie in [1, {}], got {}", std::numeric_limits<int>::max(), every));
+    c.probe_every = static_cast<int>(every);
     o->finish();
   }
   for (const io::Section& p : root.tables("probe")) {
     ProbeSpec spec;
     spec.name = p.string("name");
+    // The name heads columns of probes.csv ("name.field"): nothing that breaks a CSV header.
+    p.require(!spec.name.empty(), "name", "must not be empty (it heads the probe's columns in probes.csv)");
+    for (const char ch : spec.name) {
+      const auto u = static_cast<unsigned char>(ch);
+      if (ch == ',' || ch == '"' || u < 0x20 || u == 0x7f) {
+        p.fail("name", fmt::format("must not contain {} (the name heads the probe's columns in probes.csv)",
+                                   ch == ','   ? std::string("a comma")
+                                   : ch == '"' ? std::string("a double quote")
+                                               : fmt::format("a control character (code {})", static_cast<int>(u))));
+      }
+    }
     spec.where = p.where("position");
     spec.position = p.numbers("position");
     if (static_cast<int>(spec.position.size()) != Dim) {
@@ -449,6 +513,7 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     c.probes.push_back(std::move(spec));
   }
   root.finish();
+  for (const std::string& w : c.warnings) std::cerr << "warning: " << w << "\n";
   return c;
 }
 

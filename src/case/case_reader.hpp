@@ -26,6 +26,12 @@ CaseDocument load_case_document(const std::string& file, const std::vector<std::
 /// The same from the text of a case (a checkpoint's copy of it); `label` names it in errors.
 CaseDocument parse_case_document(const std::string& text, const std::string& label,
                                  const std::vector<std::string>& overrides);
+/// Apply one --set key=value to a parsed document: the value is one TOML value (or a bare word,
+/// read as a string); array-of-tables entries are indexed from 0 (boundary.1.stress.xx). Throws
+/// InputError naming `file` and the assignment.
+void apply_override(toml::table& root, const std::string& assignment, const std::string& file);
+/// The value of an override as the document "v = value"; `label` starts its error messages.
+toml::table parse_override_value(const std::string& label, const std::string& text);
 /// The dimension of space of a case (geometry.dimension), checked.
 int case_dimension(const CaseDocument& doc);
 

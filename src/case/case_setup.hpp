@@ -14,6 +14,9 @@
 
 namespace rktsph {
 
+/// Default of time.max_steps: a run of more steps must say so in its case file.
+inline constexpr double kDefaultMaxSteps = 1.0e8;
+
 /// Nodes selected by an axis-aligned box; an axis left open selects everything along it.
 template <int Dim>
 struct Region {
@@ -154,6 +157,9 @@ struct CaseSetup {
   double end_time = 0.0;
   std::optional<double> cfl;
   std::optional<double> dt;
+  /// time.max_steps: the run is refused before it starts if end_time / dt exceeds it
+  /// (case/size_limits.hpp).
+  double max_steps = kDefaultMaxSteps;
 
   // solver
   /// The scheme, by its registry name (solver.version): "v1" dry, "v3" saturated (the v-p_w
@@ -177,6 +183,10 @@ struct CaseSetup {
   bool output_elements = true;
   int probe_every = 1;
   std::vector<ProbeSpec> probes;
+
+  /// Warnings of the reader (also written to stderr when the case is read), e.g. snapshot
+  /// times past the end.
+  std::vector<std::string> warnings;
 
   std::vector<std::string> function_names;
   std::vector<TimeFunction> functions;

@@ -4,11 +4,12 @@
 
 #include <cmath>
 #include <filesystem>
-#include <sstream>
+#include <limits>
 
 #include <fmt/format.h>
 #include <toml++/toml.h>
 
+#include "case/case_reader.hpp"
 #include "case/material_reader.hpp"
 #include "core/error.hpp"
 #include "io/section.hpp"
@@ -16,50 +17,6 @@
 namespace rktsph {
 
 namespace {
-
-// Apply one "a.b.c=value" override. Scalars are rebuilt as fresh nodes so that error messages
-// say "value set on the command line" instead of quoting a line of the override text.
-void apply_override(toml::table& root, const std::string& assignment) {
-  const auto eq = assignment.find('=');
-  if (eq == std::string::npos || eq == 0) {
-    throw InputError(fmt::format("override '{}': expected key=value, e.g. material.E=2.5e7", assignment));
-  }
-  const std::string key = assignment.substr(0, eq);
-  const std::string text = assignment.substr(eq + 1);
-  std::vector<std::string> parts;
-  std::stringstream ss(key);
-  for (std::string p; std::getline(ss, p, '.');) parts.push_back(p);
-  toml::table* t = &root;
-  for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
-    toml::node* next = t->get(parts[i]);
-    if (next == nullptr) {
-      t->insert(parts[i], toml::table{});
-      next = t->get(parts[i]);
-    }
-    t = next->as_table();
-    if (t == nullptr) {
-      throw InputError(fmt::format("override '{}': '{}' is not a table", assignment, parts[i]));
-    }
-  }
-  toml::table parsed;
-  try {
-    parsed = toml::parse("v = " + text);
-  } catch (const toml::parse_error&) {
-    parsed = toml::table{{"v", text}};
-  }
-  const toml::node& v = *parsed.get("v");
-  if (auto i = v.value_exact<std::int64_t>()) {
-    t->insert_or_assign(parts.back(), *i);
-  } else if (auto d = v.value_exact<double>()) {
-    t->insert_or_assign(parts.back(), *d);
-  } else if (auto b = v.value_exact<bool>()) {
-    t->insert_or_assign(parts.back(), *b);
-  } else if (auto s = v.value_exact<std::string>()) {
-    t->insert_or_assign(parts.back(), *s);
-  } else {
-    t->insert_or_assign(parts.back(), v);
-  }
-}
 
 Sym6 read_sym6(const io::Section& s) {
   Sym6 out{};
@@ -114,9 +71,20 @@ LoadPath read_path(const io::Section& s, std::string& type, std::string& plot_st
   }
   path.duration = s.positive("duration");
   path.dt = s.positive("dt", path.duration / 1000.0);
+  // Size guards: the steps of the path and the rows kept in memory and written to path.csv.
+  const double steps = std::ceil(path.duration / path.dt);
+  s.require(steps <= kDefaultMaxSteps, "dt",
+            fmt::format("duration / dt = {} s / {} s = {:.4g} steps, more than {:.0e}: use a larger dt", path.duration,
+                        path.dt, steps, kDefaultMaxSteps));
   const std::int64_t every = s.integer("output_every", 1);
-  s.require(every >= 1, "output_every", fmt::format("must be >= 1, got {}", every));
+  s.require(every >= 1 && every <= std::numeric_limits<int>::max(), "output_every",
+            fmt::format("must lie in [1, {}], got {}", std::numeric_limits<int>::max(), every));
   path.output_every = static_cast<int>(every);
+  constexpr double kMaxRows = 1.0e7;
+  s.require(steps / static_cast<double>(every) <= kMaxRows, "output_every",
+            fmt::format("{} steps with a row every {} make {:.4g} rows of path.csv, more than {:.0e}: raise "
+                        "output_every",
+                        steps, every, steps / static_cast<double>(every), kMaxRows));
   s.finish();
   return path;
 }
@@ -133,7 +101,7 @@ MaterialPointCase load_material_point_case(const std::string& case_file, const s
   } catch (const toml::parse_error& e) {
     throw InputError(fmt::format("{}, line {}: {}", case_file, e.source().begin.line, e.description()));
   }
-  for (const std::string& o : overrides) apply_override(root, o);
+  for (const std::string& o : overrides) apply_override(root, o, case_file);
   const io::Section top(root, "", std::make_shared<const std::string>(case_file));
 
   MaterialPointCase c;

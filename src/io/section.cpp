@@ -66,12 +66,28 @@ std::string_view type_name(const toml::node& n) {
       return "a date or time";
   }
 }
+// A float, or an integer as the nearest double. (toml++'s value<double>() gives nothing for an
+// integer that a double does not hold exactly, such as 9223372036854775807.)
+std::optional<double> number_value(const toml::node& n) {
+  if (n.is_floating_point()) return n.as_floating_point()->get();
+  if (n.is_integer()) return static_cast<double>(n.as_integer()->get());
+  return std::nullopt;
+}
+
+std::string magnitude_message(double v) {
+  return fmt::format(
+      "{} is beyond {:.0e} in magnitude: not a physical value in SI units (products and squares of "
+      "such numbers overflow)",
+      v, Section::kMaxMagnitude);
+}
+
 }  // namespace
 
 double Section::number(std::string_view key) const {
   const toml::node& n = required(key);
-  if (auto v = n.value<double>(); v && (n.is_floating_point() || n.is_integer())) {
+  if (auto v = number_value(n)) {
     if (!std::isfinite(*v)) fail(key, "must be a finite number");
+    if (!(std::abs(*v) <= kMaxMagnitude)) fail(key, magnitude_message(*v));
     return *v;
   }
   fail(key, fmt::format("must be a number, got {}", type_name(n)));
@@ -137,11 +153,11 @@ std::vector<double> Section::numbers(std::string_view key) const {
   if (arr == nullptr) fail(key, fmt::format("must be an array of numbers, got {}", type_name(n)));
   std::vector<double> out;
   for (const toml::node& item : *arr) {
-    if (!(item.is_floating_point() || item.is_integer())) {
-      fail(key, fmt::format("must be an array of numbers, but an element is {}", type_name(item)));
-    }
-    const double v = item.value<double>().value();
+    const std::optional<double> value = number_value(item);
+    if (!value) fail(key, fmt::format("must be an array of numbers, but an element is {}", type_name(item)));
+    const double v = *value;
     if (!std::isfinite(v)) fail(key, "must hold finite numbers");
+    if (!(std::abs(v) <= kMaxMagnitude)) fail(key, magnitude_message(v));
     out.push_back(v);
   }
   return out;

@@ -21,6 +21,10 @@ namespace rktsph::io {
 
 class Section {
  public:
+  /// Numbers are finite and at most this in magnitude: no quantity of a case in SI units comes
+  /// near it (a modulus of 1e12 Pa, a time of 1e10 s), and squares of larger ones overflow.
+  static constexpr double kMaxMagnitude = 1.0e100;
+
   Section(const toml::table& table, std::string path, std::shared_ptr<const std::string> file);
 
   /// Full dotted path of a key of this table, e.g. "material.E".

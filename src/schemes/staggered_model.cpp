@@ -6,7 +6,9 @@
 
 #include <fmt/format.h>
 
+#include "case/size_limits.hpp"
 #include "core/error.hpp"
+#include "schemes/registry.hpp"
 
 namespace rktsph {
 
@@ -48,6 +50,12 @@ std::vector<std::string> stress_names() {
 template <int Dim>
 StaggeredModel<Dim>::StaggeredModel(CaseSetup<Dim> case_setup, exec::Threads threads)
     : setup(std::move(case_setup)), policy(threads), kernel(setup.h_over_dx * setup.dx) {
+  // Size guards (case/size_limits.hpp) for cases built in code; the case reader has checked a
+  // case file already, at the keys' lines. The lattice first, before it is generated.
+  auto size_error = [this](const SizeProblem& p) {
+    return InputError(fmt::format("{}, key '{}': {}", setup.file, p.full_key(), p.message));
+  };
+  if (auto p = lattice_size_problem(setup)) throw size_error(*p);
   materials.models = setup.materials;
   std::vector<double> densities;
   for (const auto& m : materials.models) {
@@ -58,6 +66,16 @@ StaggeredModel<Dim>::StaggeredModel(CaseSetup<Dim> case_setup, exec::Threads thr
   materials.history = HistoryLayout(materials.models);
 
   LatticeParticles<Dim> lat = generate_lattice<Dim>(setup.blocks, setup.dx, setup.origin, densities);
+  {
+    // The memory estimate with the exact particle counts, before fields and operators.
+    const SchemeInfo* scheme = find_scheme<Dim>(setup.version);
+    double cells = 1.0;
+    for (const int n : lat.lattice.cells) cells *= static_cast<double>(n);
+    if (auto p = memory_problem(setup, scheme != nullptr && scheme->pore_fluid, static_cast<double>(lat.nodes.size()),
+                                static_cast<double>(lat.stress_points.size()), cells)) {
+      throw size_error(*p);
+    }
+  }
   lattice = std::move(lat.lattice);
   nodes = std::move(lat.nodes);
   boundary = std::move(lat.boundary);

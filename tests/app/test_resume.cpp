@@ -247,7 +247,7 @@ TEST(Resume, KillNineNeverLeavesUnreadableOutput) {
   const std::string bin = RKTSPH_BINARY;
   std::mt19937 rng(5);
   std::uniform_int_distribution<int> ms(20, 400);
-  const std::vector<std::string> every_step = {"--set", "output.interval=1e-9", "--set",
+  const std::vector<std::string> every_step = {"--set", "output.interval=1e-7", "--set",
                                                "output.checkpoint_interval=0.05"};
   auto command = [&](const std::string& out) {
     std::vector<std::string> c = {bin, "run", file, "--out", out, "-q", "-j", "1"};

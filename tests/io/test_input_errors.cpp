@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "../support/test_util.hpp"
+#include "case/size_limits.hpp"
 
 namespace rktsph {
 namespace {
@@ -269,6 +270,296 @@ TEST(InputErrors, SetOverrideWithWrongType) {
   {
     // A good override runs.
     const auto o = run_case_text(dir, kBase, {"material.E=2.0e7"});
+    EXPECT_EQ(o.status, 0) << o.err;
+  }
+}
+
+// ---- size guards (case/size_limits.hpp, docs/case-format.md "Size limits")
+
+TEST(InputErrors, StepCountBeyondMaxSteps) {
+  test::TempDir dir;
+  {
+    // Used to overflow the step count: 0 steps, "completed".
+    const auto o = run_case_text(dir, kBase, {"time.end=1e30"});
+    expect_input_error(o, "time.end", {"command line", "steps", "time.max_steps", "1e+15"});
+  }
+  {
+    // A light material: c = 4e13 m/s, 1.5e11 steps (used to run until killed).
+    const auto o = run_case_text(dir, kBase, {"material.density=1e-20"});
+    expect_error_at(o, line_of(kBase, "end = "), "time.end", {"steps", "c = ", "time.max_steps"});
+  }
+}
+
+TEST(InputErrors, MaxStepsAllowsALongerRun) {
+  test::TempDir dir;
+  // dt = 0.5 * 0.5 m / 82.04 m/s = 3.047e-3 s: 0.05 s is 16.4 steps.
+  {
+    const auto o = run_case_text(dir, kBase, {"time.end=0.05", "time.max_steps=10"});
+    expect_input_error(o, "time.end", {"16.4", "time.max_steps (>= 17)"});
+  }
+  {
+    const auto o = run_case_text(dir, kBase, {"time.end=0.05", "time.max_steps=17"});
+    EXPECT_EQ(o.status, 0) << o.err;
+  }
+  for (const char* bad : {"time.max_steps=0", "time.max_steps=1e16", "time.max_steps=-5"}) {
+    const auto o = run_case_text(dir, kBase, {bad});
+    expect_input_error(o, "time.max_steps", {"[1, 1e+15]"});
+  }
+}
+
+TEST(InputErrors, TinySpacingNamesTheSpacing) {
+  test::TempDir dir;
+  // Used to overflow the lattice's int coordinates and report a misaligned block.
+  const std::string text = replace(kBase, "spacing = 0.5", "spacing = 1.0e-12");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "spacing"), "geometry.spacing", {"geometry.block[0]", "cells per axis"});
+}
+
+TEST(InputErrors, BlockFarFromTheOrigin) {
+  test::TempDir dir;
+  const auto o = run_case_text(dir, kBase, {"geometry.origin=[1.0e12, 0.0]"});
+  expect_error_at(o, line_of(kBase, "min = "), "geometry.block[0].min", {"spacings", "geometry.origin"});
+}
+
+TEST(InputErrors, BlocksSpanningTooManyCells) {
+  test::TempDir dir;
+  // Each block is small and near enough to the origin, but together they span 6e8 cells.
+  const std::string text = replace(replace(kBase, "spacing = 0.5", "spacing = 1.0"), "[material]",
+                                   "[[geometry.block]]\nmin = [-3.0e8, 0.0]\nmax = [-2.99999998e8, 1.0]\n\n"
+                                   "[[geometry.block]]\nmin = [3.0e8, 0.0]\nmax = [3.00000002e8, 1.0]\n\n[material]");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "spacing"), "geometry.spacing", {"blocks together span 6e+08 cells", "per axis"});
+}
+
+TEST(InputErrors, TooManyParticles) {
+  test::TempDir dir;
+  // 2e5 x 1e5 cells: 2e10 particles, more than a 32-bit index.
+  const std::string text = replace(kBase, "spacing = 0.5", "spacing = 1.0e-5");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "spacing"), "geometry.spacing", {"2147483647 particles"});
+}
+
+TEST(InputErrors, MemoryEstimateAboveThePhysicalMemory) {
+  test::TempDir dir;
+  // 4e4 x 2e4 cells: 8e8 nodes, about 520 GiB at 700 bytes per node (a dry 2D case).
+  const double need = 8.0e8 * bytes_per_node(2, false);
+  if (physical_memory_bytes() >= need) GTEST_SKIP() << "this machine has more than " << need << " bytes";
+  const std::string text = replace(kBase, "spacing = 0.5", "spacing = 5.0e-5");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "spacing"), "geometry.spacing",
+                  {"8e+08 nodes", "GiB", "bytes per node", "memory", "larger spacing"});
+}
+
+// ---- numbers
+
+TEST(InputErrors, IntegerBeyondADoubleIsANumber) {
+  test::TempDir dir;
+  // An integer a double does not hold exactly used to be "not a number" (and, in an array, an
+  // uncaught std::bad_optional_access, exit 1).
+  const std::string text = replace(kBase, "min = [0.0, 0.0]", "min = [9223372036854775807, 0.0]");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "min = "), "geometry.block[0].min", {"spacings"});
+  const auto e = run_case_text(dir, replace(kBase, "E = 1.0e7", "E = 9223372036854775807"), {"time.max_steps=10"});
+  expect_input_error(e, "time.end", {"steps"});
+}
+
+TEST(InputErrors, NumbersBeyondThePhysicalRange) {
+  test::TempDir dir;
+  for (const char* bad : {"E = 1.0e300", "E = -1.0e101"}) {
+    const std::string text = replace(kBase, "E = 1.0e7", bad);
+    const auto o = run_case_text(dir, text);
+    expect_error_at(o, line_of(text, bad), "material.E", {"1e+100"});
+  }
+  const std::string text = replace(kBase, "position = [2.0, 1.0]", "position = [2.0, 1e200]");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "position = "), "probe[0].position", {"1e+100"});
+}
+
+TEST(InputErrors, IntegersBeyondTheirRange) {
+  test::TempDir dir;
+  {
+    // 2^32 + 1 used to wrap to 1.
+    const std::string text = replace(kBase, "[[probe]]", "[output]\nprobe_every = 4294967297\n\n[[probe]]");
+    const auto o = run_case_text(dir, text);
+    expect_error_at(o, line_of(text, "probe_every"), "output.probe_every", {"2147483647"});
+  }
+  {
+    const std::string text =
+        replace(kBase, "[time]", "[solver]\npressure_max_iterations = 9223372036854775807\n[time]");
+    const auto o = run_case_text(dir, text);
+    expect_error_at(o, line_of(text, "pressure_max_iterations"), "solver.pressure_max_iterations", {"2147483647"});
+  }
+}
+
+// ---- output
+
+TEST(InputErrors, OutputIntervalFarBelowTheStep) {
+  test::TempDir dir;
+  // The frame clock would need 1e297 rounds (and stall below the clock's rounding): a hang.
+  const std::string text = replace(kBase, "[[probe]]", "[output]\ninterval = 1.0e-300\n\n[[probe]]");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "interval"), "output.interval", {"time.max_steps", "time step"});
+}
+
+TEST(InputErrors, SnapshotTimesPastTheEndWarn) {
+  test::TempDir dir;
+  const std::string text = replace(kBase, "[[probe]]", "[output]\ntimes = [0.0005, 5.0, 2.0]\n\n[[probe]]");
+  const std::string file = dir.write("late.toml", text);
+  const auto r = test::run_command(
+      fmt::format("\"{}\" run \"{}\" --out \"{}\" -q 2>&1 1>/dev/null", RKTSPH_BINARY, file, dir.file("out")));
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(r.out.find("warning: "), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(file), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find(fmt::format("line {}, key 'output.times'", line_of(text, "times = "))), std::string::npos)
+      << r.out;
+  EXPECT_NE(r.out.find("2 of the snapshot times (2, 5 s) are past time.end = 0.001 s"), std::string::npos) << r.out;
+  // The reader keeps the warning for callers that print their own.
+  const auto setup = test::case_from_string<2>(dir, text);
+  ASSERT_EQ(setup.warnings.size(), 1u);
+}
+
+TEST(InputErrors, NegativeSnapshotTime) {
+  test::TempDir dir;
+  const std::string text = replace(kBase, "[[probe]]", "[output]\ntimes = [0.0005, -1.0]\n\n[[probe]]");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "times = "), "output.times", {">= 0"});
+}
+
+TEST(InputErrors, ProbeNamesThatBreakTheCsvHeader) {
+  test::TempDir dir;
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {R"(name = "a,b")", "a comma"},
+      {R"(name = "a\"b")", "a double quote"},
+      {R"(name = "a\nb")", "a control character (code 10)"},
+      {R"(name = "a\tb")", "a control character (code 9)"},
+      {R"(name = "")", "must not be empty"},
+  };
+  for (const auto& [line, why] : bad) {
+    const std::string text = replace(kBase, "name = \"corner\"", line);
+    const auto o = run_case_text(dir, text);
+    expect_error_at(o, line_of(text, line), "probe[0].name", {why, "probes.csv"});
+  }
+  // Dots, blanks and other printable characters are fine.
+  const auto o = run_case_text(dir, replace(kBase, "name = \"corner\"", "name = \"top corner (x=2).v\""));
+  EXPECT_EQ(o.status, 0) << o.err;
+}
+
+// ---- --set
+
+TEST(InputErrors, SetWithTextAfterTheValue) {
+  test::TempDir dir;
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"time.end=1.0abc", "'1.0' is a value but 'abc' follows it"},
+      {"solver.version=\"v1\"x", "'\"v1\"' is a value but 'x' follows it"},
+      {"geometry.origin=[0.0, 0.0]x", "'[0.0, 0.0]' is a value but 'x' follows it"},
+      {"time.end=0.001 # a comment", "text after the value: '# a comment'"},
+      {"time.end=0.001\nmaterial.E=1", "text after the value: 'material.E=1'"},
+      {"time.end=", "no value after '='"},
+      {"geometry.origin=[0.0, 0.0", "is not a valid TOML value"},
+      {"title=\"unclosed", "is not a valid TOML value"},
+  };
+  for (const auto& [set, why] : bad) {
+    const auto o = run_case_text(dir, kBase, {set});
+    expect_input_error(o, "", {"--set '", why});
+  }
+  // A bare word is still a string, and blanks around a value are fine.
+  for (const char* good : {"solver.version=v1", "title=a bare title", "time.end= 0.001 "}) {
+    const auto o = run_case_text(dir, kBase, {good});
+    EXPECT_EQ(o.status, 0) << good << ": " << o.err;
+  }
+}
+
+TEST(InputErrors, SetKeyPaths) {
+  test::TempDir dir;
+  {
+    const auto o = run_case_text(dir, kBase, {"time.end.x=1.0"});
+    expect_input_error(
+        o, "", {"--set '", fmt::format("'time.end' is a value (line {}), not a table", line_of(kBase, "end = "))});
+  }
+  {
+    // std::stoul read "0x" as 0.
+    const auto o = run_case_text(dir, kBase, {"boundary.0x.name=a"});
+    expect_input_error(o, "", {"--set '", "'0x' indexes an array and must be a whole number"});
+  }
+  {
+    const auto o = run_case_text(dir, kBase, {"boundary.3.name=a"});
+    expect_input_error(o, "", {"--set '", "index 3 is past the end of the array (1 entries)"});
+  }
+  for (const char* bad : {"time..end=1.0", ".time.end=1.0", "time.end.=1.0", "time. end=1.0"}) {
+    const auto o = run_case_text(dir, kBase, {bad});
+    expect_input_error(o, "", {"--set '", "empty or blank-padded part"});
+  }
+}
+
+// ---- material-point inputs (case/material_point_reader.cpp)
+
+constexpr const char* kMaterialPoint = R"([material]
+model = "perzyna_von_mises"
+E = 1.0e7
+nu = 0.3
+density = 2000.0
+cohesion = 5.0e4
+fluidity = 1.0
+
+[initial]
+stress = { xx = -1.0e5, yy = -1.0e5, zz = -1.0e5 }
+
+[path]
+type = "simple_shear"
+shear_strain_rate = 0.01
+duration = 1.0
+dt = 0.01
+
+[output]
+plot = false
+)";
+
+Outcome run_material_point_text(const test::TempDir& dir, const std::string& text,
+                                const std::vector<std::string>& sets = {}) {
+  const std::string file = dir.write("bad_point.toml", text);
+  std::string cmd = fmt::format("\"{}\" material-point \"{}\" --out \"{}\"", RKTSPH_BINARY, file, dir.file("out"));
+  for (const auto& s : sets) cmd += fmt::format(" --set '{}'", s);
+  cmd += " 2>&1 1>/dev/null";
+  const auto r = test::run_command(cmd);
+  return {r.status, r.out, file};
+}
+
+TEST(InputErrors, MaterialPointBaseRuns) {
+  test::TempDir dir;
+  const auto o = run_material_point_text(dir, kMaterialPoint);
+  EXPECT_EQ(o.status, 0) << o.err;
+}
+
+TEST(InputErrors, MaterialPointStepsAndRows) {
+  test::TempDir dir;
+  {
+    // 1e300 steps used to run until killed.
+    const std::string text = replace(kMaterialPoint, "dt = 0.01", "dt = 1.0e-300");
+    const auto o = run_material_point_text(dir, text);
+    expect_error_at(o, line_of(text, "dt = "), "path.dt", {"steps", "larger dt"});
+  }
+  {
+    // 5e7 steps, each a row: 5e7 rows held in memory and written.
+    const std::string text = replace(kMaterialPoint, "dt = 0.01", "dt = 2.0e-8");
+    const auto o = run_material_point_text(dir, text);
+    expect_input_error(o, "path.output_every", {"rows of path.csv", "raise output_every"});
+  }
+  {
+    const std::string text = replace(kMaterialPoint, "dt = 0.01", "dt = 0.01\noutput_every = 4294967297");
+    const auto o = run_material_point_text(dir, text);
+    expect_error_at(o, line_of(text, "output_every"), "path.output_every", {"2147483647"});
+  }
+}
+
+TEST(InputErrors, MaterialPointSetIsCheckedLikeRun) {
+  test::TempDir dir;
+  {
+    const auto o = run_material_point_text(dir, kMaterialPoint, {"material.E=1.0e7abc"});
+    expect_input_error(o, "", {"--set '", "'1.0e7' is a value but 'abc' follows it"});
+  }
+  {
+    // Array-of-tables entries and plain keys work as with run.
+    const auto o = run_material_point_text(dir, kMaterialPoint, {"material.E=2.0e7", "path.duration=0.5"});
     EXPECT_EQ(o.status, 0) << o.err;
   }
 }
