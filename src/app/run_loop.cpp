@@ -93,13 +93,12 @@ int run_loop(const LoopInput& in) {
   const auto t_setup = Clock::now();
   const CaseSetup<Dim> setup = read_case<Dim>(in.document);
   Simulation<Dim> solver(setup);
-  if (resuming) solver.load_state(*in.checkpoint);
   const double setup_seconds = std::chrono::duration<double>(Clock::now() - t_setup).count();
   const io::FieldCatalogue<Dim> node_fields(solver, io::FieldCatalogue<Dim>::Set::nodes);
   const io::FieldCatalogue<Dim> stress_point_fields(solver, io::FieldCatalogue<Dim>::Set::stress_points);
   const PorePressureStage<Dim>* pressure = solver.scheme().template find<PorePressureStage<Dim>>();
 
-  // Probes: the nearest node; a probe outside the body is an input error.
+  // Probes: the node nearest the position in the initial configuration; outside the body, an input error.
   struct Probe {
     std::string name;
     Index node;
@@ -134,14 +133,17 @@ int run_loop(const LoopInput& in) {
     }
     probes.push_back(std::move(p));
   }
+  // After the probes: a probe follows the node nearest its position as the case made the nodes,
+  // which in large deformation have moved by the time of a checkpoint.
+  if (resuming) solver.load_state(*in.checkpoint);
 
   const double dt = solver.dt();
   const long total_steps = static_cast<long>(std::ceil(setup.end_time / dt - 1e-9));
   const double checkpoint_every = setup.checkpoint_interval.value_or(setup.end_time / 10.0);
   LoopState loop;
   if (resuming && solver.step_count() > total_steps) {
-    throw InputError(fmt::format("{}: the checkpoint is at t = {:.6g} s (step {}), past time.end = {:.6g} s", out.string(),
-                                 solver.time(), solver.step_count(), setup.end_time));
+    throw InputError(fmt::format("{}: the checkpoint is at t = {:.6g} s (step {}), past time.end = {:.6g} s",
+                                 out.string(), solver.time(), solver.step_count(), setup.end_time));
   }
   if (resuming && solver.step_count() == total_steps) {
     if (!opt.quiet) {
@@ -167,7 +169,8 @@ int run_loop(const LoopInput& in) {
     for (const auto& entry : fs::directory_iterator(out / "vtu")) {
       const std::string f = entry.path().filename().string();
       long index = -1;
-      if (std::sscanf(f.c_str(), "nodes_%ld.vtu", &index) == 1 || std::sscanf(f.c_str(), "elements_%ld.vtu", &index) == 1) {
+      if (std::sscanf(f.c_str(), "nodes_%ld.vtu", &index) == 1 ||
+          std::sscanf(f.c_str(), "elements_%ld.vtu", &index) == 1) {
         if (index >= loop.frame) fs::remove(entry.path());
       }
     }
@@ -209,9 +212,10 @@ int run_loop(const LoopInput& in) {
     // A stress can overflow while every velocity is still finite (the step's own check looks at
     // the velocities): an infinite energy is an unstable run, never a completed one.
     if (!std::isfinite(e.kinetic + e.strain + e.external_work + e.damping_loss)) {
-      throw SolverError(fmt::format("the energy became non-finite at t = {:.6g} s (step {}): the run is unstable; "
-                                    "reduce the time step (time.cfl = {:.3g}) or check the loads and material parameters",
-                                    solver.time(), solver.step_count(), solver.cfl()));
+      throw SolverError(
+          fmt::format("the energy became non-finite at t = {:.6g} s (step {}): the run is unstable; "
+                      "reduce the time step (time.cfl = {:.3g}) or check the loads and material parameters",
+                      solver.time(), solver.step_count(), solver.cfl()));
     }
     energy_csv.append(fmt::format("{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g}\n", solver.time(), e.kinetic,
                                   e.strain - e.initial_strain, e.external_work, e.damping_loss, e.imbalance()));
@@ -362,9 +366,10 @@ int run_loop(const LoopInput& in) {
           solver.cfl() * PorePressureStage<Dim>::kUndrainedCourantLimit / pressure->undrained_courant());
     }
     if (solver.degenerate_operator_rows() > 0) {
-      std::cerr << fmt::format("warning: {} particles have too few neighbours for the corrected operator and use "
-                               "plain SPH sums\n",
-                               solver.degenerate_operator_rows());
+      std::cerr << fmt::format(
+          "warning: {} particles have too few neighbours for the corrected operator and use "
+          "plain SPH sums\n",
+          solver.degenerate_operator_rows());
     }
   }
 
@@ -465,10 +470,11 @@ int run_loop(const LoopInput& in) {
   if (!opt.quiet) {
     if (pressure != nullptr) {
       const PressureSolveStats& ps = pressure->stats();
-      std::cerr << fmt::format("pore pressure: {} PCG solves, iterations mean {:.1f} / max {}, final relative "
-                               "residual {:.2e}; pressure step {:.0f} % of the loop time\n",
-                               ps.solves, ps.mean_iterations(), ps.max_iterations, ps.last_error,
-                               seconds > 0 ? 100.0 * pressure->seconds() / seconds : 0.0);
+      std::cerr << fmt::format(
+          "pore pressure: {} PCG solves, iterations mean {:.1f} / max {}, final relative "
+          "residual {:.2e}; pressure step {:.0f} % of the loop time\n",
+          ps.solves, ps.mean_iterations(), ps.max_iterations, ps.last_error,
+          seconds > 0 ? 100.0 * pressure->seconds() / seconds : 0.0);
     }
     const double node_steps = static_cast<double>(solver.nodes().size()) *
                               static_cast<double>(solver.step_count() - std::max(0L, loop.resumed_from));

@@ -11,7 +11,7 @@ namespace rktsph {
 
 template <int Dim>
 void NodalConstraints<Dim>::resolve(const std::vector<BoundarySpec<Dim>>& specs, const ParticleSet<Dim>& nodes,
-                                    const BoundaryNodes<Dim>& boundary, double dx) {
+                                    const BoundaryNodes<Dim>& boundary, double dx, bool free_faces) {
   const auto nn = static_cast<std::size_t>(nodes.size());
   const std::vector<std::uint8_t> node_faces = boundary.dense_faces(nodes.size());
   std::vector<std::vector<NodalConstraint>> per_node(nn);
@@ -106,6 +106,7 @@ void NodalConstraints<Dim>::resolve(const std::vector<BoundarySpec<Dim>>& specs,
   for (std::size_t i = 0; i < nn; ++i) {
     const std::uint8_t faces = node_faces[i];
     auto& list = per_node[i];
+    if (!free_faces && list.empty()) continue;
     std::uint8_t reaction = 0;  // stress slots that are reactions at this node
     for (int d = 0; d < Dim; ++d) {
       if ((faces & (3u << (2 * d))) == 0) continue;

@@ -28,9 +28,11 @@ template <int Dim>
 class NodalConstraints {
  public:
   /// Resolve the case's boundary entries on the nodes. Throws InputError naming an entry that
-  /// selects no node.
+  /// selects no node. With `free_faces = false` the traction-free default is kept only at nodes
+  /// an entry selects (they stay on their wall); the other face nodes are left to free-surface
+  /// detection (V2).
   void resolve(const std::vector<BoundarySpec<Dim>>& specs, const ParticleSet<Dim>& nodes,
-               const BoundaryNodes<Dim>& boundary, double dx);
+               const BoundaryNodes<Dim>& boundary, double dx, bool free_faces = true);
 
   /// Constraints of node i: list()[k] for k in [row(i), row(i + 1)), sorted by component.
   Index begin(Index i) const { return row_[static_cast<std::size_t>(i)]; }

@@ -109,7 +109,8 @@ class CaseBuilder {
     return *this;
   }
   /// 2D: an initial rigid motion v = velocity + omega e_z x (x - centre).
-  CaseBuilder& initial_velocity(const Vec<Dim>& velocity, double omega = 0.0, const Vec<Dim>& centre = Vec<Dim>::Zero()) {
+  CaseBuilder& initial_velocity(const Vec<Dim>& velocity, double omega = 0.0,
+                                const Vec<Dim>& centre = Vec<Dim>::Zero()) {
     c_.initial_velocity = velocity;
     c_.initial_angular_velocity = omega;
     c_.initial_rotation_centre = centre;
@@ -139,9 +140,16 @@ class CaseBuilder {
     c_.cfl.reset();
     return *this;
   }
-  /// The scheme by registry name ("v1", "v3", ...).
+  /// The scheme by registry name ("v1", "v3", ...); V2 in 2D and 3D detects its free surface
+  /// by default, as the reader does.
   CaseBuilder& scheme(const std::string& version) {
     c_.version = version;
+    c_.detect_free_surface = version == "v2" && Dim >= 2;
+    return *this;
+  }
+  /// solver.free_surface: detected ("detect", V2 in 2D/3D) or the lattice faces ("faces").
+  CaseBuilder& free_surface(bool detect) {
+    c_.detect_free_surface = detect;
     return *this;
   }
   CaseBuilder& fluid(const FluidSpec& f) {
@@ -158,6 +166,8 @@ class CaseBuilder {
   CaseSetup<Dim> build() const {
     CaseSetup<Dim> c = c_;
     auto fail = [&](const std::string& what) { throw InputError(fmt::format("{}: {}", c.file, what)); };
+    if (c.detect_free_surface && (c.version != "v2" || Dim < 2))
+      fail("free-surface detection needs the V2 scheme in 2D or 3D");
     if (!(c.dx > 0.0)) fail("the spacing must be > 0");
     if (c.materials.empty()) fail("no material");
     if (blocks_.empty()) fail("no block");

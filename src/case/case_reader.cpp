@@ -288,13 +288,17 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     is->finish();
   }
   if (auto iv = root.optional_table("initial_velocity")) {
-    if (iv->has("velocity")) c.initial_velocity = read_vector<Dim>(*iv, "velocity");
-    else iv->number("velocity", 0.0);
+    if (iv->has("velocity"))
+      c.initial_velocity = read_vector<Dim>(*iv, "velocity");
+    else
+      iv->number("velocity", 0.0);
     if (iv->has("angular_velocity")) {
       if (Dim != 2) iv->fail("angular_velocity", "a rigid rotation is available in 2D only");
       c.initial_angular_velocity = iv->number("angular_velocity");
-      if (iv->has("centre")) c.initial_rotation_centre = read_vector<Dim>(*iv, "centre");
-      else iv->number("centre", 0.0);
+      if (iv->has("centre"))
+        c.initial_rotation_centre = read_vector<Dim>(*iv, "centre");
+      else
+        iv->number("centre", 0.0);
     } else {
       iv->number("angular_velocity", 0.0);
       iv->number("centre", 0.0);
@@ -350,9 +354,24 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
       s->fail("scheme", fmt::format("unknown scheme '{}' (known: staggered, collocated)", scheme));
     c.filter = s->boolean("filter", true);
     const std::string velocity_update = s->string("velocity_update", "simple");
-    if (velocity_update == "simple") c.simple_velocity = true;
-    else if (velocity_update == "taylor_galerkin") c.simple_velocity = false;
-    else s->fail("velocity_update", fmt::format("unknown value '{}' (known: simple, taylor_galerkin)", velocity_update));
+    if (velocity_update == "simple")
+      c.simple_velocity = true;
+    else if (velocity_update == "taylor_galerkin")
+      c.simple_velocity = false;
+    else
+      s->fail("velocity_update", fmt::format("unknown value '{}' (known: simple, taylor_galerkin)", velocity_update));
+    const bool can_detect = c.version == "v2" && Dim >= 2;
+    const std::string surface = s->string("free_surface", can_detect ? "detect" : "faces");
+    if (surface == "detect") {
+      s->require(can_detect, "free_surface",
+                 "\"detect\" needs solver.version = \"v2\" in 2D or 3D (small-deformation schemes keep the "
+                 "faces of the lattice, a 1D bar's ends are its surface)");
+      c.detect_free_surface = true;
+    } else if (surface == "faces") {
+      c.detect_free_surface = false;
+    } else {
+      s->fail("free_surface", fmt::format("unknown value '{}' (known: detect, faces)", surface));
+    }
     c.filter_strength = s->number("filter_strength", 0.5);
     s->require(c.filter_strength > 0.0 && c.filter_strength <= 1.0, "filter_strength",
                fmt::format("must lie in (0, 1], got {}", c.filter_strength));
@@ -477,8 +496,10 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
       o->number("times", 0.0);
     }
     c.output_elements = o->boolean("elements", true);
-    if (o->has("checkpoint_interval")) c.checkpoint_interval = o->non_negative("checkpoint_interval", 0.0);
-    else o->number("checkpoint_interval", 0.0);
+    if (o->has("checkpoint_interval"))
+      c.checkpoint_interval = o->non_negative("checkpoint_interval", 0.0);
+    else
+      o->number("checkpoint_interval", 0.0);
     const std::int64_t every = o->integer("probe_every", 1);
     o->require(every >= 1 && every <= std::numeric_limits<int>::max(), "probe_every",
                fmt::format("must lie in [1, {}], got {}", std::numeric_limits<int>::max(), every));

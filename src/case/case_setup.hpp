@@ -172,6 +172,11 @@ struct CaseSetup {
   /// V2: the nodal velocity of step 2 by the simple scheme (method-notes §2.3), or V1's
   /// Taylor-Galerkin step 2 (solver.velocity_update = "taylor_galerkin", for comparison).
   bool simple_velocity = true;
+  /// The traction-free surface (method-notes §3.6-3.7, §4.1): on the faces of the initial
+  /// lattice in global axes (V1, V3, and V2 in 1D), or, for V2 in 2D and 3D, detected on the
+  /// current positions every step with its normals, the stress rotated to sigma.n = 0 there
+  /// (solver.free_surface = "faces" | "detect").
+  bool detect_free_surface = false;
   SourceCoupling coupling = SourceCoupling::additive;
 
   // output

@@ -11,7 +11,7 @@
 namespace rktsph::io {
 
 /// The format of the checkpoint files this program writes and reads.
-inline constexpr int kCheckpointFormat = 1;
+inline constexpr int kCheckpointFormat = 2;  // 2: the sets' fingerprints as made from the case
 
 void write_checkpoint(const std::string& path, const StateArchive& archive);
 StateArchive read_checkpoint(const std::string& path);

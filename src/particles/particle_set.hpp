@@ -62,8 +62,8 @@ class ParticleSet {
       throw SolverError(fmt::format("{}: the field '{}' is registered twice", name_, field_name));
     }
     Column c;
-    c.info = {std::move(field_name), field_type_of<T>(), N > 0 ? N : components, std::move(component_names), flags,
-              kind};
+    c.info = {
+        std::move(field_name), field_type_of<T>(), N > 0 ? N : components, std::move(component_names), flags, kind};
     c.resize(position.size());
     columns_.push_back(std::move(c));
     return Field<T, N>{static_cast<int>(columns_.size()) - 1};
@@ -98,7 +98,8 @@ class ParticleSet {
   template <class T>
   std::span<T> values(int id) {
     Column& c = column(id);
-    if (c.info.type != field_type_of<T>()) throw SolverError(fmt::format("{}: field '{}' has another type", name_, c.info.name));
+    if (c.info.type != field_type_of<T>())
+      throw SolverError(fmt::format("{}: field '{}' has another type", name_, c.info.name));
     const auto n = static_cast<std::size_t>(size()) * static_cast<std::size_t>(c.info.components);
     return {c.template data<T>(), n};
   }
@@ -114,6 +115,22 @@ class ParticleSet {
     return out;
   }
   const FieldInfo& info(int id) const { return column(id).info; }
+
+  /// A hash (FNV-1a) of the particles as they are now: positions, volumes, materials and ids,
+  /// bit for bit. Taken when a set is made from a case, it identifies that case's particles
+  /// after they have moved (checkpoints).
+  std::uint64_t fingerprint() const {
+    std::uint64_t h = 1469598103934665603ull;
+    auto mix = [&h](const void* data, std::size_t n) {
+      const auto* b = static_cast<const unsigned char*>(data);
+      for (std::size_t k = 0; k < n; ++k) h = (h ^ b[k]) * 1099511628211ull;
+    };
+    for (const auto& x : position) mix(x.data(), sizeof(double) * Dim);
+    mix(volume.data(), volume.size() * sizeof(double));
+    mix(material.data(), material.size() * sizeof(int));
+    mix(global_id.data(), global_id.size() * sizeof(std::int64_t));
+    return h;
+  }
 
   /// Bytes held by the properties and the fields whose flags intersect `flags` (all by default).
   std::size_t bytes(unsigned flags = ~0u) const {

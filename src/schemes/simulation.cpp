@@ -15,7 +15,9 @@ template <int Dim>
 Simulation<Dim>::Simulation(CaseSetup<Dim> setup, exec::Threads policy)
     : model_(std::make_unique<StaggeredModel<Dim>>(std::move(setup), policy)),
       scheme_(create_scheme<Dim>(model_->setup.version, *model_)),
-      clock_(model_->setup, model_->time_step) {
+      clock_(model_->setup, model_->time_step),
+      nodes_made_(model_->nodes.fingerprint()),
+      stress_points_made_(model_->stress_points.fingerprint()) {
   model_->set_initial_state();
   clock_.start(energy().strain, model_->boundary_power(), balance_sums());
 }

@@ -109,6 +109,8 @@ class Simulation {
   std::unique_ptr<Scheme> scheme_;
   TimeControl<Dim> clock_;
   exec::ReductionScratch reduction_;
+  /// ParticleSet::fingerprint of the nodes and the stress points as made from the case.
+  std::uint64_t nodes_made_ = 0, stress_points_made_ = 0;
 };
 
 }  // namespace rktsph

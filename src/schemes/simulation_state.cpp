@@ -13,8 +13,9 @@ namespace rktsph {
 namespace {
 
 template <int Dim>
-void save_set(const ParticleSet<Dim>& set, io::StateArchive& a) {
+void save_set(const ParticleSet<Dim>& set, std::uint64_t made, io::StateArchive& a) {
   const std::string p = set.name() + "/";
+  a.put_integer(p + "made_from_case", static_cast<std::int64_t>(made));
   std::vector<double> x;
   x.reserve(set.position.size() * Dim);
   for (const auto& v : set.position) {
@@ -54,25 +55,29 @@ void save_set(const ParticleSet<Dim>& set, io::StateArchive& a) {
 template <class T>
 void copy_into(std::span<T> to, const std::vector<T>& from, const std::string& key) {
   if (from.size() != to.size()) {
-    throw InputError(fmt::format("the checkpoint's '{}' has {} values, this case {}: the case changed since it was written",
-                                 key, from.size(), to.size()));
+    throw InputError(
+        fmt::format("the checkpoint's '{}' has {} values, this case {}: the case changed since it was written", key,
+                    from.size(), to.size()));
   }
   std::copy(from.begin(), from.end(), to.begin());
 }
 
 template <int Dim>
-void load_set(ParticleSet<Dim>& set, const io::StateArchive& a) {
+void load_set(ParticleSet<Dim>& set, std::uint64_t made, const io::StateArchive& a) {
   const std::string p = set.name() + "/";
-  // The particles are made again from the case; they must be the checkpoint's, bit for bit.
+  // The particles are made again from the case; as made they must be the checkpoint's, bit for
+  // bit (a fingerprint, since in large deformation they have moved since).
   const auto& x = a.doubles(p + "position");
-  bool same = x.size() == set.position.size() * Dim && a.integers(p + "global_id") == set.global_id;
-  for (std::size_t i = 0; same && i < set.position.size(); ++i) {
-    for (int d = 0; d < Dim; ++d) same = same && x[i * Dim + static_cast<std::size_t>(d)] == set.position[i][d];
-  }
+  const bool same = x.size() == set.position.size() * Dim && a.integers(p + "global_id") == set.global_id &&
+                    static_cast<std::uint64_t>(a.integer(p + "made_from_case")) == made;
   if (!same) {
-    throw InputError(fmt::format("the checkpoint's {} are not this case's ({} in the checkpoint, {} here): the case "
-                                 "changed since it was written",
-                                 set.name(), x.size() / Dim, set.position.size()));
+    throw InputError(
+        fmt::format("the checkpoint's {} are not this case's ({} in the checkpoint, {} here): the case "
+                    "changed since it was written",
+                    set.name(), x.size() / Dim, set.position.size()));
+  }
+  for (std::size_t i = 0; i < set.position.size(); ++i) {
+    for (int d = 0; d < Dim; ++d) set.position[i][d] = x[i * Dim + static_cast<std::size_t>(d)];
   }
   copy_into(std::span<double>(set.volume), a.doubles(p + "volume"), p + "volume");
   copy_into(std::span<double>(set.density), a.doubles(p + "density"), p + "density");
@@ -83,14 +88,22 @@ void load_set(ParticleSet<Dim>& set, const io::StateArchive& a) {
     const std::string key = p + "fields/" + f.name;
     const int i = static_cast<int>(id);
     switch (f.type) {
-      case FieldType::f64: copy_into(set.template values<double>(i), a.doubles(key), key); break;
-      case FieldType::i64: copy_into(set.template values<std::int64_t>(i), a.integers(key), key); break;
-      case FieldType::u8: copy_into(set.template values<std::uint8_t>(i), a.bytes(key), key); break;
+      case FieldType::f64:
+        copy_into(set.template values<double>(i), a.doubles(key), key);
+        break;
+      case FieldType::i64:
+        copy_into(set.template values<std::int64_t>(i), a.integers(key), key);
+        break;
+      case FieldType::u8:
+        copy_into(set.template values<std::uint8_t>(i), a.bytes(key), key);
+        break;
     }
   }
 }
 
-std::string stage_prefix(std::size_t index, std::string_view name) { return fmt::format("stages/{:02d}_{}/", index, name); }
+std::string stage_prefix(std::size_t index, std::string_view name) {
+  return fmt::format("stages/{:02d}_{}/", index, name);
+}
 
 }  // namespace
 
@@ -98,8 +111,8 @@ template <int Dim>
 void Simulation<Dim>::save_state(io::StateArchive& a) const {
   a.put_text("scheme/name", scheme_->name());
   a.put_integer("scheme/dimension", Dim);
-  save_set(model_->nodes, a);
-  save_set(model_->stress_points, a);
+  save_set(model_->nodes, nodes_made_, a);
+  save_set(model_->stress_points, stress_points_made_, a);
   clock_.save(a);
   for (std::size_t k = 0; k < scheme_->stages().size(); ++k) {
     const Stage& s = *scheme_->stages()[k];
@@ -113,8 +126,8 @@ void Simulation<Dim>::load_state(const io::StateArchive& a) {
     throw InputError(fmt::format("the checkpoint is of the {}D scheme '{}', this case runs the {}D scheme '{}'",
                                  a.integer("scheme/dimension"), a.text("scheme/name"), Dim, scheme_->name()));
   }
-  load_set(model_->nodes, a);
-  load_set(model_->stress_points, a);
+  load_set(model_->nodes, nodes_made_, a);
+  load_set(model_->stress_points, stress_points_made_, a);
   clock_.load(a);
   for (std::size_t k = 0; k < scheme_->stages().size(); ++k) {
     Stage& s = *scheme_->stages()[k];

@@ -124,7 +124,7 @@ StaggeredModel<Dim>::StaggeredModel(CaseSetup<Dim> case_setup, exec::Threads thr
   node_sources = make_source_runs(nodes, materials);
   stress_point_sources = make_source_runs(stress_points, materials);
 
-  constraints.resolve(setup.boundaries, nodes, boundary, setup.dx);
+  constraints.resolve(setup.boundaries, nodes, boundary, setup.dx, !setup.detect_free_surface);
   std::vector<Vec<Dim>> constrained_positions;
   for (const Index i : constraints.constrained())
     constrained_positions.push_back(nodes.position[static_cast<std::size_t>(i)]);

@@ -1,12 +1,14 @@
 // V2: the staggered RKT-SPH step for dry soil in large deformation (method-notes §5.2):
-//   0. neighbours and operators rebuilt from the current positions (never frozen);
+//   0. neighbours and operators rebuilt from the current positions (never frozen); in 2D and
+//      3D the free surface detected and the nodal stress made traction-free on it;
 //   1. stress points: half step from the nodes, with the Jaumann rotation, the continuity
 //      equation and the new positions;
 //   2. nodes: the stress by step 2 with the Jaumann rotation, the velocity by the simple
 //      scheme (solver.velocity_update = "simple", default) or V1's step 2
 //      ("taylor_galerkin"), continuity, positions and displacements;
 //   3. prescribed components at t^{n+1} (and V1's velocity filter with the Taylor-Galerkin
-//      update only: the simple scheme has no nodal mode to filter).
+//      update only: the simple scheme has no nodal mode to filter); the free surface made
+//      traction-free again on the stress at t^{n+1}.
 #include <chrono>
 #include <memory>
 
@@ -20,7 +22,16 @@ template <int Dim>
 std::unique_ptr<Scheme> make_v2_scheme(StaggeredModel<Dim>& model) {
   auto scheme = std::make_unique<Scheme>("v2");
   auto sources = std::make_shared<ViscoplasticSources<Dim>>(model);
-  scheme->add(std::make_unique<RebuildOperators<Dim>>(model));
+  auto rebuild = std::make_unique<RebuildOperators<Dim>>(model);
+  DetectFreeSurface<Dim>* surface = nullptr;
+  if (model.setup.detect_free_surface) {
+    auto detect = std::make_unique<DetectFreeSurface<Dim>>(model, *rebuild);
+    surface = detect.get();
+    scheme->add(std::move(rebuild));
+    scheme->add(std::move(detect));
+  } else {
+    scheme->add(std::move(rebuild));
+  }
   scheme->add(std::make_unique<StressPointHalfStep<Dim, NoPressureGradient, MovingParticles>>(model, sources));
   if (model.setup.simple_velocity) {
     scheme->add(std::make_unique<NodeFullStep<Dim, MovingParticles, SimpleVelocity>>(model, sources));
@@ -33,6 +44,7 @@ std::unique_ptr<Scheme> make_v2_scheme(StaggeredModel<Dim>& model) {
       scheme->add(std::make_unique<ApplyConstraints<Dim>>(model));
     }
   }
+  if (surface != nullptr) scheme->add(std::make_unique<SurfaceTractionFree<Dim>>(*surface));
   return scheme;
 }
 

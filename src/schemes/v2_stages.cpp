@@ -29,6 +29,11 @@ void RebuildOperators<Dim>::build_relations() {
   RelationOptions diff = difference_gradient_relation_options(m_.kernel);
   diff.radius += skin_;
   constrained_.build(constrained_positions_, m_.stress_points.position, diff, m_.policy);
+  if (m_.setup.detect_free_surface) {
+    RelationOptions own = operator_relation_options(m_.kernel);
+    own.radius += skin_;
+    node_neighbours_.build(m_.nodes.position, m_.nodes.position, own, m_.policy);
+  }
   nodes_at_build_ = m_.nodes.position;
   stress_points_at_build_ = m_.stress_points.position;
   ++relation_builds_;
@@ -62,8 +67,54 @@ void RebuildOperators<Dim>::run(const StepContext&) {
   operator_seconds_ += since(t0);
 }
 
+template <int Dim>
+DetectFreeSurface<Dim>::DetectFreeSurface(StaggeredModel<Dim>& model, const RebuildOperators<Dim>& rebuild)
+    : m_(model), rebuild_(rebuild) {
+  std::vector<std::string> normal_names;
+  for (int d = 0; d < Dim; ++d) normal_names.push_back(std::string("n") + "xyz"[d]);
+  flag_field_ = m_.nodes.template add_field<double, 1>("free_surface", {"free_surface"}, kFieldOutput | kFieldEvolving);
+  normal_field_ =
+      m_.nodes.template add_field<double, Dim>("normal", normal_names, kFieldOutput, Dim, FieldKind::vector);
+  const auto nn = static_cast<std::size_t>(m_.nodes.size());
+  excluded_.assign(nn, 0);
+  for (const Index i : m_.constraints.constrained()) excluded_[static_cast<std::size_t>(i)] = 1;
+  previous_.reserve(nn);
+  flags_.reserve(nn);
+  normals_.reserve(nn);
+}
+
+template <int Dim>
+void DetectFreeSurface<Dim>::run(const StepContext&) {
+  const auto t0 = Clock::now();
+  auto flag = m_.nodes.view(flag_field_);
+  auto normal = m_.nodes.view(normal_field_);
+  const auto nn = static_cast<std::size_t>(m_.nodes.size());
+  previous_.resize(nn);
+  for (std::size_t i = 0; i < nn; ++i) previous_[i] = flag(i, 0) != 0.0 ? 1 : 0;
+  detect_free_surface<Dim>(m_.nodes, rebuild_.node_neighbours(), m_.kernel, FreeSurfaceOptions{}, previous_, excluded_,
+                           flags_, normals_, m_.policy);
+  surface_.clear();
+  for (std::size_t i = 0; i < nn; ++i) {
+    flag(i, 0) = flags_[i];
+    for (int d = 0; d < Dim; ++d) normal(i, d) = normals_[i][d];
+    if (flags_[i] != 0) surface_.push_back(static_cast<Index>(i));
+  }
+  surface_nodes_ = static_cast<Index>(surface_.size());
+  make_surface_traction_free();
+  seconds_ += since(t0);
+}
+
+template <int Dim>
+void DetectFreeSurface<Dim>::make_surface_traction_free() {
+  auto stress = m_.nodes.view(m_.fields.stress);
+  for (const Index i : surface_) make_traction_free<Dim>(normals_[static_cast<std::size_t>(i)], stress[i]);
+}
+
 template class RebuildOperators<1>;
 template class RebuildOperators<2>;
 template class RebuildOperators<3>;
+template class DetectFreeSurface<1>;
+template class DetectFreeSurface<2>;
+template class DetectFreeSurface<3>;
 
 }  // namespace rktsph

@@ -1,9 +1,12 @@
 #pragma once
 // The stages V2 adds to V1's (method-notes §5.2): the neighbour relations and corrected
 // operators rebuilt from the current positions at the start of every step.
+#include <cstdint>
 #include <string_view>
+#include <vector>
 
 #include "neighbours/relation.hpp"
+#include "operators/free_surface.hpp"
 #include "schemes/stage.hpp"
 #include "schemes/staggered_model.hpp"
 
@@ -21,7 +24,7 @@ class RebuildOperators final : public Stage {
   std::string_view name() const override { return "rebuild_operators"; }
   void run(const StepContext& context) override;
   std::size_t scratch_bytes() const override {
-    return to_stress_points_.bytes() + to_nodes_.bytes() + constrained_.bytes();
+    return to_stress_points_.bytes() + to_nodes_.bytes() + constrained_.bytes() + node_neighbours_.bytes();
   }
 
   /// Relations rebuilt (neighbour searches), operators recomputed, and the time of each, s.
@@ -31,6 +34,9 @@ class RebuildOperators final : public Stage {
   double operator_seconds() const { return operator_seconds_; }
   /// The skin of the Verlet lists, m.
   double skin() const { return skin_; }
+  /// The nodes' own Verlet neighbours (within the support plus the skin), for free-surface
+  /// detection; empty unless the case detects its free surface.
+  const Relation<Dim>& node_neighbours() const { return node_neighbours_; }
   std::vector<std::pair<std::string, double>> report() const override {
     return {{"neighbour_searches", static_cast<double>(relation_builds_)},
             {"neighbour_search_seconds", relation_seconds_},
@@ -44,11 +50,58 @@ class RebuildOperators final : public Stage {
 
   StaggeredModel<Dim>& m_;
   double skin_;
-  Relation<Dim> to_stress_points_, to_nodes_, constrained_;
+  Relation<Dim> to_stress_points_, to_nodes_, constrained_, node_neighbours_;
   std::vector<Vec<Dim>> constrained_positions_;
   std::vector<Vec<Dim>> nodes_at_build_, stress_points_at_build_;
   long relation_builds_ = 0, operator_builds_ = 0;
   double relation_seconds_ = 0.0, operator_seconds_ = 0.0;
+};
+
+/// The free surface of the nodes detected on their positions at t^n (method-notes §3.6), after
+/// RebuildOperators, and the nodal stress there made traction-free in the local normal frame
+/// (§3.7) before the stress points read it. Nodes that a boundary entry selects are never
+/// flagged: their conditions are the entry's (and the lattice face's, which they stay on). The
+/// flags are a particle field ("free_surface", 1 on the surface) saved in checkpoints, as the
+/// next detection's temporal coherence reads them; "normal" holds the outward normals.
+template <int Dim>
+class DetectFreeSurface final : public Stage {
+ public:
+  DetectFreeSurface(StaggeredModel<Dim>& model, const RebuildOperators<Dim>& rebuild);
+  std::string_view name() const override { return "free_surface"; }
+  void run(const StepContext& context) override;
+  std::size_t scratch_bytes() const override {
+    return previous_.capacity() + flags_.capacity() + excluded_.capacity() + normals_.capacity() * sizeof(Vec<Dim>);
+  }
+  /// sigma.n = 0 at the flagged nodes with the normals of the last detection.
+  void make_surface_traction_free();
+  std::vector<std::pair<std::string, double>> report() const override {
+    return {{"surface_nodes_last_step", static_cast<double>(surface_nodes_)}, {"detection_seconds", seconds_}};
+  }
+
+ private:
+  StaggeredModel<Dim>& m_;
+  const RebuildOperators<Dim>& rebuild_;
+  Field<double, 1> flag_field_;
+  Field<double, Dim> normal_field_;
+  std::vector<std::uint8_t> previous_, flags_, excluded_;
+  std::vector<Vec<Dim>> normals_;
+  std::vector<Index> surface_;  // the flagged nodes
+  Index surface_nodes_ = 0;
+  double seconds_ = 0.0;
+};
+
+/// The traction-free condition again at the end of the step, on the nodal stress at t^{n+1},
+/// with the normals found at t^n (the particles have moved by v dt, a fraction of the spacing):
+/// the written frames and the next step start from a traction-free surface.
+template <int Dim>
+class SurfaceTractionFree final : public Stage {
+ public:
+  explicit SurfaceTractionFree(DetectFreeSurface<Dim>& detect) : detect_(detect) {}
+  std::string_view name() const override { return "surface_traction_free"; }
+  void run(const StepContext&) override { detect_.make_surface_traction_free(); }
+
+ private:
+  DetectFreeSurface<Dim>& detect_;
 };
 
 }  // namespace rktsph

@@ -142,6 +142,20 @@ TEST(InputErrors, IncrementalProjectionWithStressPointDivergence) {
   expect_error_at(o, line_of(text, "pressure_incremental"), "solver.pressure_incremental", {"unstable"});
 }
 
+TEST(InputErrors, FreeSurfaceDetectionNeedsV2) {
+  test::TempDir dir;
+  const std::string text = replace(kBase, "[time]", "[solver]\nfree_surface = \"detect\"\n[time]");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "free_surface"), "solver.free_surface", {"v2"});
+}
+
+TEST(InputErrors, UnknownFreeSurface) {
+  test::TempDir dir;
+  const std::string text = replace(kBase, "[time]", "[solver]\nversion = \"v2\"\nfree_surface = \"auto\"\n[time]");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "free_surface"), "solver.free_surface", {"detect", "faces"});
+}
+
 TEST(InputErrors, PressureFilterOutOfRange) {
   test::TempDir dir;
   const std::string text = replace(kBase, "[time]", "[solver]\npressure_filter = -1.0\n[time]");

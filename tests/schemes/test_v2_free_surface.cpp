@@ -1,0 +1,103 @@
+// V2's free surface (method-notes §3.6-3.7) on a spinning elastic square, free of any boundary
+// entry: after a turn of about 34 degrees the flagged nodes are the square's faces, the
+// detected normals are its rotated face normals, and the nodal stress is traction-free in the
+// rotated frame. Keeping the faces of the initial lattice (global axes) instead leaves a
+// traction of the order of the stress on the turned faces.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "../support/test_util.hpp"
+#include "case/case_builder.hpp"
+#include "schemes/simulation.hpp"
+
+namespace rktsph {
+namespace {
+
+struct SpinResult {
+  double theta = 0.0;              // rad, the turn fitted to the node positions
+  int face_nodes = 0;              // nodes on the square's faces (away from the corners)
+  int wrongly_flagged = 0;         // interior nodes flagged, or face nodes not flagged
+  double worst_normal_angle = 0;   // rad, detected against the rotated face normal
+  double traction_residual = 0.0;  // max |sigma n| over the face nodes / max |sigma|, n exact
+};
+
+SpinResult spin(bool detect) {
+  const test::ThreadCount threads(1);
+  const double omega = 0.6;  // rad/s
+  CaseBuilder<2> b("spinning square");
+  b.spacing(0.1)
+      .origin(Vec<2>(-1.0, -1.0))
+      .block(Vec<2>(-1.0, -1.0), Vec<2>(1.0, 1.0))
+      .elastic(1.0e7, 0.3, 2000.0)
+      .scheme("v2")
+      .free_surface(detect)
+      .initial_velocity(Vec<2>::Zero(), omega)
+      .time(1.0, 0.5);
+  Simulation<2> sim(b.build());
+  const std::vector<Vec<2>> start = sim.nodes().position;
+  while (sim.time() < 1.0 - 1e-12) sim.step();
+
+  SpinResult r;
+  const auto& x = sim.nodes().position;
+  double cross = 0.0, dot = 0.0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    cross += start[i][0] * x[i][1] - start[i][1] * x[i][0];
+    dot += start[i].dot(x[i]);
+  }
+  r.theta = std::atan2(cross, dot);
+  const double c = std::cos(r.theta), s = std::sin(r.theta);
+  const auto stress = sim.node_stress();
+  double scale = 0.0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const double sxx = stress(i, StressComponent::xx), syy = stress(i, StressComponent::yy);
+    const double sxy = stress(i, StressComponent::xy);
+    scale = std::max(scale, std::sqrt(sxx * sxx + syy * syy + 2.0 * sxy * sxy));
+  }
+  const Field<double, 1> flag_field = sim.nodes().template find<double, 1>("free_surface");
+  const Field<double, 2> normal_field = sim.nodes().template find<double, 2>("normal");
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const bool on_x_face = std::abs(std::abs(start[i][0]) - 1.0) < 1e-9;
+    const bool on_y_face = std::abs(std::abs(start[i][1]) - 1.0) < 1e-9;
+    if (detect) {
+      const bool flagged = sim.nodes().view(flag_field)(i, 0) != 0.0;
+      if (flagged != (on_x_face || on_y_face)) ++r.wrongly_flagged;
+    }
+    if (on_x_face == on_y_face) continue;                        // interior, or a corner (no single normal)
+    if (std::abs(start[i][on_x_face ? 1 : 0]) > 0.75) continue;  // chords to a corner bend the normal
+    ++r.face_nodes;
+    const Vec<2> n0 =
+        on_x_face ? Vec<2>(std::copysign(1.0, start[i][0]), 0.0) : Vec<2>(0.0, std::copysign(1.0, start[i][1]));
+    const Vec<2> n(c * n0[0] - s * n0[1], s * n0[0] + c * n0[1]);
+    if (detect) {
+      const auto nd = sim.nodes().view(normal_field);
+      const Vec<2> found(nd(i, 0), nd(i, 1));
+      r.worst_normal_angle = std::max(r.worst_normal_angle, std::acos(std::clamp(found.dot(n), -1.0, 1.0)));
+    }
+    const double tx = stress(i, StressComponent::xx) * n[0] + stress(i, StressComponent::xy) * n[1];
+    const double ty = stress(i, StressComponent::xy) * n[0] + stress(i, StressComponent::yy) * n[1];
+    r.traction_residual = std::max(r.traction_residual, std::hypot(tx, ty) / scale);
+  }
+  return r;
+}
+
+TEST(V2FreeSurface, ASpinningSquareKeepsItsFacesTractionFreeInTheTurnedFrame) {
+  const SpinResult detected = spin(true);
+  const SpinResult faces = spin(false);
+  EXPECT_NEAR(detected.theta, 0.6, 0.02);
+  EXPECT_EQ(detected.face_nodes, 4 * 15);
+  EXPECT_EQ(detected.wrongly_flagged, 0);
+  // Measured: 0.021 degrees and a residual of 2e-4 of the peak stress, against 0.55 with the
+  // lattice faces. Within 2 dx of a corner the chords to the other face bend the normal (7
+  // degrees at 2 dx): a corner has no single normal, and those nodes are left out here.
+  EXPECT_LT(detected.worst_normal_angle, 0.5 * std::numbers::pi / 180.0);
+  EXPECT_LT(detected.traction_residual, 0.01);
+  EXPECT_GT(faces.traction_residual, 0.2);
+  std::printf("theta %.4f rad; normals within %.3f deg; traction residual %.4f (detected) %.4f (lattice faces)\n",
+              detected.theta, detected.worst_normal_angle * 180.0 / std::numbers::pi, detected.traction_residual,
+              faces.traction_residual);
+}
+
+}  // namespace
+}  // namespace rktsph
