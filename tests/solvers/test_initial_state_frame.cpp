@@ -113,7 +113,8 @@ TEST(InitialStateFrame, ElementsFrameAtTimeZeroShowsTheUniformInitialStress) {
   test::TempDir dir;
   const std::string file = dir.write("uniform.toml", kUniformCase);
   const std::string out = dir.file("out");
-  const auto r = test::run_command(fmt::format("\"{}\" run \"{}\" --out \"{}\" -q -j 1 2>&1", RKTSPH_BINARY, file, out));
+  const auto r =
+      test::run_command(fmt::format("\"{}\" run \"{}\" --out \"{}\" -q -j 1 2>&1", RKTSPH_BINARY, file, out));
   ASSERT_EQ(r.status, 0) << r.out;
   const std::pair<const char*, double> expected[] = {{"sxx", -5.0e4}, {"syy", -2.0e4}, {"szz", -3.0e4}, {"sxy", 4.0e3}};
   for (const char* set : {"elements", "nodes"}) {
