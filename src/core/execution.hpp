@@ -58,10 +58,12 @@ inline bool& adaptive_teams() {
 /// The choice between the whole team and one thread for every adaptive loop. An epoch is at
 /// least kEpochCalls loop calls and kEpochSeconds of their wall time, all run one way; its
 /// throughput (particles / loop seconds) is kept, the last kSamples per way, and each way is
-/// judged by their median, so that one epoch hit by a burst of load does not decide. The loops
-/// run on the better way; after the first epoch of each, the other is tried for one epoch every
-/// `probe_interval()` epochs, an interval that grows fourfold (up to kMaxProbe) each time the
-/// trial confirms the choice and restarts at kMinProbe when the choice changes.
+/// judged by their median, so that one epoch hit by a burst of load does not decide. The very
+/// first epoch is not kept (it holds the team's start, the first touches of the arrays and, in
+/// a run, the set-up's loops, a mix unlike the steps'); then one epoch runs each way. The loops
+/// run on the better way; the other is tried for one epoch every `probe_interval()` epochs, an
+/// interval that grows fourfold (up to kMaxProbe) each time the trial confirms the choice and
+/// restarts at kMinProbe when the choice changes.
 ///
 /// Epochs of many calls compare the ways in the conditions they run in (a team woken at every
 /// loop, a step's mix of loops); single calls tried alone were measured to favour one thread
@@ -76,7 +78,7 @@ class TeamChoice {
   static constexpr int kSamples = 3;
   static constexpr int kMinProbe = 4;
   static constexpr int kMaxProbe = 64;
-  static constexpr double kMargin = 0.9;  // the other way must be 10 % faster to take over
+  static constexpr double kMargin = 0.95;  // the other way must be 5 % faster to take over
 
   /// Whether the loops of the current epoch run on the team.
   bool team() const { return epoch_team_; }
@@ -101,12 +103,13 @@ class TeamChoice {
     time_ += seconds;
     if (++calls_ < kEpochCalls || time_ < kEpochSeconds) return;
     const int k = epoch_team_ ? 1 : 0;
-    rate_[k][count_[k] % kSamples] = work_ / time_;
-    ++count_[k];
-    ++epochs_;
+    const double rate = work_ / time_;
     work_ = time_ = 0.0;
     calls_ = 0;
-    if (count_[0] == 0 || count_[1] == 0) {  // the first epoch of each way: team, then one thread
+    if (epochs_++ == 0) return;  // the first: the team's start, first touches, a set-up's loops
+    rate_[k][count_[k] % kSamples] = rate;
+    ++count_[k];
+    if (count_[0] == 0 || count_[1] == 0) {  // then one epoch of each way: team, one thread
       epoch_team_ = count_[1] == 0;
       return;
     }

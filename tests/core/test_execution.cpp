@@ -124,6 +124,18 @@ TEST(TeamChoice, FollowsTheLoadBothWays) {
   EXPECT_TRUE(choice.chosen());
 }
 
+TEST(TeamChoice, TheFirstEpochIsNotKept) {
+  // A run's first loops: the team's start and the set-up's heavier loops, 10x slower per
+  // particle than the steps' on the team; then the steps, where the team is twice as fast.
+  exec::TeamChoice choice;
+  feed(choice, {2e6, 1e7}, exec::TeamChoice::kEpochCalls);
+  const Outcome o = feed(choice, {2e7, 1e7}, 5000);
+  EXPECT_TRUE(choice.chosen());
+  // Never switched: the one-thread epoch of the start and trials after 16, 64 and 128 epochs.
+  EXPECT_EQ(choice.probe_interval(), exec::TeamChoice::kMaxProbe);
+  EXPECT_LE(o.single_calls, 4 * exec::TeamChoice::kEpochCalls);
+}
+
 TEST(TeamChoice, OneSlowEpochDoesNotDecide) {
   exec::TeamChoice choice;
   feed(choice, {2e7, 1e7}, 5000);
