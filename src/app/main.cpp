@@ -65,7 +65,6 @@ int available_cpus() {
 int resolve_threads(int requested) {
   const int cpus = available_cpus();
   const bool from_option = requested > 0;
-  rktsph::exec::adaptive_teams() = !from_option && std::getenv("OMP_NUM_THREADS") == nullptr;
   const int wanted = from_option ? requested : omp_get_max_threads();
   if (wanted > cpus) {
     std::cerr << fmt::format(
@@ -76,6 +75,7 @@ int resolve_threads(int requested) {
   }
   const int threads = std::min(wanted, cpus);
   omp_set_num_threads(threads);
+  rktsph::exec::adaptive_teams() = !from_option && std::getenv("OMP_NUM_THREADS") == nullptr && threads > 1;
   return threads;
 }
 
