@@ -1,6 +1,10 @@
 // rktsph: Runge–Kutta Taylor SPH for the dynamics of dry and saturated soils.
 #include <omp.h>
+#include <sched.h>
+#include <unistd.h>
 
+#include <algorithm>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <string>
@@ -13,11 +17,73 @@
 #include "app/run_case.hpp"
 #include "case/material_reader.hpp"
 #include "core/error.hpp"
+#include "core/execution.hpp"
 #include "rktsph/version.hpp"
 #include "validation/validation.hpp"
 
+namespace {
+
+// Threads (docs/architecture.md, "Execution").
+//
+// Wait policy. libgomp's waiting threads spin (GOMP_SPINCOUNT = 300000 by default) at every
+// barrier and between parallel regions. When another process keeps a core busy, a thread of
+// ours that shares its core is preempted while the others spin for it, holding the cores it
+// could run on: the default two threads measured 5.7x slower than one thread on the V1
+// benchmark and 19x on a V3 run. With OMP_WAIT_POLICY=passive a waiting thread sleeps at once,
+// its core goes idle and the scheduler moves the preempted thread there. libgomp reads the
+// variable when it is loaded, before main, so it cannot be set from here: the program runs
+// itself again (/proc/self/exe, same pid, arguments and environment) with the variable set,
+// unless the user has set OMP_WAIT_POLICY or GOMP_SPINCOUNT, whose choice is then kept. If the
+// exec fails the run goes on with the runtime's own policy.
+void ensure_passive_wait_policy(char** argv) {
+  if (std::getenv("OMP_WAIT_POLICY") != nullptr || std::getenv("GOMP_SPINCOUNT") != nullptr) return;
+  if (::setenv("OMP_WAIT_POLICY", "passive", 0) != 0) return;
+  ::execv("/proc/self/exe", argv);
+  ::unsetenv("OMP_WAIT_POLICY");  // exec failed: nothing changed, the runtime keeps its default
+}
+
+// The CPUs this process may run on (its affinity mask: taskset, cgroup cpusets, a batch
+// scheduler's allocation), else what OpenMP counts.
+int available_cpus() {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  if (::sched_getaffinity(0, sizeof(set), &set) == 0) {
+    const int n = CPU_COUNT(&set);
+    if (n > 0) return n;
+  }
+  return std::max(1, omp_get_num_procs());
+}
+
+// The thread count of a run: --threads N, else OMP_NUM_THREADS, else every available CPU;
+// bounded by the available CPUs. More threads than CPUs only slows a run down (results are
+// bit for bit the same on any thread count), and a huge count crashes the OpenMP runtime, so
+// the count is clamped with a warning rather than refused: a job script written for a larger
+// machine still runs. With neither --threads nor OMP_NUM_THREADS, each parallel loop chooses
+// between all of them and one thread by measuring both (exec::adaptive_teams): the default must
+// not be slower than one thread when other processes keep the cores busy. A count the user
+// fixed is used as given.
+int resolve_threads(int requested) {
+  const int cpus = available_cpus();
+  const bool from_option = requested > 0;
+  const int wanted = from_option ? requested : omp_get_max_threads();
+  if (wanted > cpus) {
+    std::cerr << fmt::format(
+        "warning: {} {} thread{} but this process may run on {} CPU{}; using {} (more threads than "
+        "CPUs only slow the run down)\n",
+        from_option ? "--threads asks for" : "OMP_NUM_THREADS asks for", wanted, wanted > 1 ? "s" : "", cpus,
+        cpus > 1 ? "s" : "", cpus);
+  }
+  const int threads = std::min(wanted, cpus);
+  omp_set_num_threads(threads);
+  rktsph::exec::adaptive_teams() = !from_option && std::getenv("OMP_NUM_THREADS") == nullptr && threads > 1;
+  return threads;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   using namespace rktsph;
+  ensure_passive_wait_policy(argv);
   CLI::App app{
       "rktsph - dynamics of dry and saturated soils by the Runge-Kutta Taylor SPH method.\n"
       "Cases are TOML files (format: docs/case-format.md); results go to an output folder\n"
@@ -36,16 +102,18 @@ int main(int argc, char** argv) {
   run_cmd->add_option("--set,-s", run.overrides,
                       "Override a case key, e.g. --set material.E=2.5e7 (repeatable; checked "
                       "like the file)");
-  run_cmd->add_option("--threads,-j", run.threads, "Number of threads (default: all cores)")
+  run_cmd
+      ->add_option("--threads,-j", run.threads,
+                   "Number of threads (default: every CPU this process may use; more are clamped to that)")
       ->check(CLI::NonNegativeNumber);
   run_cmd->add_flag("--quiet,-q", run.quiet, "No progress output");
 
   RunOptions resume;
-  auto* resume_cmd = app.add_subcommand(
-      "resume", "Continue an interrupted run from its checkpoint (output folder of `rktsph run`)");
+  auto* resume_cmd =
+      app.add_subcommand("resume", "Continue an interrupted run from its checkpoint (output folder of `rktsph run`)");
   resume_cmd->add_option("folder", resume.out_dir, "Output folder of the interrupted run")->required();
   resume_cmd->add_option("--set,-s", resume.overrides, "Override time.end or an output.* key, e.g. --set time.end=20");
-  resume_cmd->add_option("--threads,-j", resume.threads, "Number of threads (default: all cores)")
+  resume_cmd->add_option("--threads,-j", resume.threads, "Number of threads (default and bound as for run)")
       ->check(CLI::NonNegativeNumber);
   resume_cmd->add_flag("--quiet,-q", resume.quiet, "No progress output");
 
@@ -70,7 +138,8 @@ int main(int argc, char** argv) {
   val_cmd->add_option("--out,-o", val.out_dir, "Report folder (default: validation)");
   val_cmd->add_option("--cases-dir", val.cases_dir, "Folder of the thesis case files");
   val_cmd->add_flag("!--no-plots", val.plots, "Skip the matplotlib plots");
-  val_cmd->add_option("--threads,-j", run.threads, "Number of threads")->check(CLI::NonNegativeNumber);
+  val_cmd->add_option("--threads,-j", run.threads, "Number of threads (default and bound as for run)")
+      ->check(CLI::NonNegativeNumber);
 
   try {
     app.parse(argc, argv);
@@ -79,11 +148,17 @@ int main(int argc, char** argv) {
   }
 
   try {
-    if (run_cmd->parsed()) return run_case(run);
-    if (resume_cmd->parsed()) return resume_case(resume);
+    if (run_cmd->parsed()) {
+      run.threads = resolve_threads(run.threads);
+      return run_case(run);
+    }
+    if (resume_cmd->parsed()) {
+      resume.threads = resolve_threads(resume.threads);
+      return resume_case(resume);
+    }
     if (mp_cmd->parsed()) return run_material_point(mp_file, mp_out, mp_overrides);
     if (val_cmd->parsed()) {
-      if (run.threads > 0) omp_set_num_threads(run.threads);
+      resolve_threads(run.threads);
       return validation::run_validation(val);
     }
     if (mat_cmd->parsed()) {

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
 #include <sstream>
 
@@ -269,6 +270,8 @@ int run_loop(const LoopInput& in) {
 
   // summary.json: written at the start (status "running") and replaced at the end.
   const int threads = omp_get_max_threads();
+  const char* omp_wait = std::getenv("OMP_WAIT_POLICY");  // set to passive by main unless the user chose
+  const std::string wait_policy = omp_wait != nullptr ? omp_wait : "runtime default";
   auto summary = [&](const std::string& status, const std::string& message, double loop_seconds) {
     const double nodes_count = static_cast<double>(solver.nodes().size());
     const double segment_steps = static_cast<double>(solver.step_count() - std::max(0L, loop.resumed_from));
@@ -295,6 +298,11 @@ int run_loop(const LoopInput& in) {
         {"steps_planned", total_steps},
         {"time", solver.time()},
         {"threads", threads},
+        {"omp_wait_policy", wait_policy},
+        {"threads_adaptive", exec::adaptive_teams()},  // and the share of those loops' calls run on all threads:
+        {"team_call_share",
+         static_cast<double>(exec::team_stats().team_calls) /
+             static_cast<double>(std::max(1L, exec::team_stats().team_calls + exec::team_stats().single_calls))},
         {"setup_seconds", setup_seconds},
         {"wall_seconds", loop_seconds},
         {"node_steps_per_second", segment_seconds > 0 ? node_steps / segment_seconds : 0.0},
@@ -346,14 +354,16 @@ int run_loop(const LoopInput& in) {
   const bool progress = !opt.quiet && isatty(fileno(stderr)) != 0;
   if (!opt.quiet) {
     if (resuming) {
-      std::cerr << fmt::format("rktsph {}: resuming {} at step {} of {} (t = {:.6g} s), {} thread{}\n", kVersion,
-                               out.string(), solver.step_count(), total_steps, solver.time(), threads,
-                               threads > 1 ? "s" : "");
+      std::cerr << fmt::format(
+          "rktsph {}: resuming {} at step {} of {} (t = {:.6g} s), {} thread{}{}, wait policy {}\n", kVersion,
+          out.string(), solver.step_count(), total_steps, solver.time(), threads, threads > 1 ? "s" : "",
+          exec::adaptive_teams() ? " (adaptive)" : "", wait_policy);
     } else {
       std::cerr << fmt::format(
-          "rktsph {}: {} ({}D, {} nodes, {} stress points, dt = {:.4g} s, C = {:.3f}, {} steps, {} thread{})\n",
+          "rktsph {}: {} ({}D, {} nodes, {} stress points, dt = {:.4g} s, C = {:.3f}, {} steps, {} thread{}{}, "
+          "wait policy {})\n",
           kVersion, opt.case_file, Dim, solver.nodes().size(), solver.stress_points().size(), dt, solver.cfl(),
-          total_steps, threads, threads > 1 ? "s" : "");
+          total_steps, threads, threads > 1 ? "s" : "", exec::adaptive_teams() ? " (adaptive)" : "", wait_policy);
     }
     if (pressure != nullptr && pressure->impermeable_stress_face_nodes() > 0 &&
         pressure->undrained_courant() > PorePressureStage<Dim>::kUndrainedCourantLimit) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -217,6 +218,30 @@ void StaggeredModel<Dim>::set_initial_state() {
     if (k.components() > 0) materials[m].initial_state(to_sym6<Dim>(s[i]), k[i]);
   }
   apply_constraints(0.0);
+
+  // The stress points' state at t = 0: the nodal state interpolated to them, as step 1 starts
+  // from it (method-notes §3.3: nodes are primary). Only the t = 0 output reads it: step 1
+  // overwrites every stress point's velocity, stress and history before anything uses them.
+  const auto node_v = std::as_const(nodes).view(fields.velocity);
+  const auto node_s = std::as_const(nodes).view(fields.stress);
+  const auto node_k = std::as_const(nodes).view(fields.history);
+  auto sp_v = stress_points.view(fields.sp_velocity);
+  auto sp_s = stress_points.view(fields.sp_stress);
+  auto sp_k = stress_points.view(fields.sp_history);
+  const int stride = sp_k.components();
+  exec::particle_for(policy, stress_points.size(), [&](Index e) {
+    for (int d = 0; d < Dim; ++d) sp_v(e, d) = 0.0;
+    for (int c = 0; c < NS; ++c) sp_s(e, c) = 0.0;
+    for (int j = 0; j < stride; ++j) sp_k(e, j) = 0.0;
+    const auto row = to_stress_points.row(e);
+    for (Index q = row.begin; q < row.end; ++q) {
+      const Index i = to_stress_points.source(row, q);
+      const double w = to_stress_points.interp[static_cast<std::size_t>(q)];
+      for (int d = 0; d < Dim; ++d) sp_v(e, d) += w * node_v(i, d);
+      for (int c = 0; c < NS; ++c) sp_s(e, c) += w * node_s(i, c);
+      for (int j = 0; j < stride; ++j) sp_k(e, j) += w * node_k(i, j);
+    }
+  });
 }
 
 template <int Dim>

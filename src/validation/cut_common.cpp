@@ -310,6 +310,23 @@ void write_snapshot_csv(const std::string& file, const CutSnapshot& s) {
   }
 }
 
+ToeScaling toe_scaling(const std::vector<double>& dx, const std::vector<double>& toe_residual, double lambda) {
+  ToeScaling t;
+  const std::size_t n = std::min(dx.size(), toe_residual.size());
+  bool finite = n >= 2;
+  for (std::size_t k = 0; k < n; ++k) {
+    t.scaled.push_back(toe_residual[k] * std::pow(dx[k], 1.0 - lambda));
+    finite = finite && std::isfinite(t.scaled.back());
+  }
+  if (!finite) {
+    t.mean = t.max_deviation = NAN;
+    return t;
+  }
+  for (double v : t.scaled) t.mean += v / static_cast<double>(n);
+  for (double v : t.scaled) t.max_deviation = std::max(t.max_deviation, std::abs(v / t.mean - 1.0));
+  return t;
+}
+
 double outcome_value(CutOutcome o) { return o == CutOutcome::stable ? 0.0 : (o == CutOutcome::collapse ? 1.0 : 2.0); }
 
 Metric outcome_metric(const std::string& name, const CutRun& r, CutOutcome expected) {

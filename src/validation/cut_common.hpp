@@ -116,6 +116,24 @@ void write_history_csv(const std::string& file, const CutRun& r);
 /// Write a snapshot as CSV (x, y, ux, uy, vx, vy, sxx, syy, sxy, eps_vp_eq).
 void write_snapshot_csv(const std::string& file, const CutSnapshot& s);
 
+/// The Williams eigenvalue of the Case 4(a) toe, where the rough (clamped) base meets the free
+/// face: a right-angled clamped-free wedge in plane strain at nu = 0.3, stresses ~ r^(lambda - 1)
+/// (scripts/williams_corner.py).
+inline constexpr double kToeWilliamsLambda = 0.7112;
+
+/// The toe-row scaling check of docs/cases.md Case 4(a) (restated criterion): under the corner
+/// singularity the toe row's residual grows as dx^(lambda - 1), so residual x dx^(1 - lambda)
+/// stays constant over the spacings when the singular field is resolved.
+struct ToeScaling {
+  std::vector<double> scaled;  // toe-row residual x dx^(1 - lambda), per spacing
+  double mean = 0.0;           // of `scaled`
+  double max_deviation = 0.0;  // max |scaled / mean - 1|
+};
+/// From the spacings dx (m) and the toe-row residuals at each (any unit); NaN figures when a
+/// residual is not finite or fewer than two spacings are given.
+ToeScaling toe_scaling(const std::vector<double>& dx, const std::vector<double>& toe_residual,
+                       double lambda = kToeWilliamsLambda);
+
 struct Metric;
 /// 0 stable, 1 collapse, 2 undecided (for a reported figure).
 double outcome_value(CutOutcome o);
