@@ -391,7 +391,8 @@ void rebuild_corrected_operator(const Relation<Dim>& candidates, const std::vect
   exec::particle_for(policy, nt, [&](Index a) {
     Index n = 0;
     const Vec<Dim>& xa = targets[static_cast<std::size_t>(a)];
-    for (const Index b : candidates.row(a)) n += (xa - sources.position[static_cast<std::size_t>(b)]).squaredNorm() < r2 ? 1 : 0;
+    for (const Index b : candidates.row(a))
+      n += (xa - sources.position[static_cast<std::size_t>(b)]).squaredNorm() < r2 ? 1 : 0;
     op.pattern_start[static_cast<std::size_t>(a) + 1] = n;
   });
   for (Index a = 0; a < nt; ++a) {
@@ -447,21 +448,18 @@ RelationOptions difference_gradient_relation_options(const CubicSplineKernel<Dim
   return {kernel.support_radius(), 1, true};
 }
 
+namespace {
+
+// Append the difference-gradient row of target a (row a of the relation) to g.
 template <int Dim>
-DifferenceGradient<Dim> build_difference_gradient(const Relation<Dim>& relation, const std::vector<Vec<Dim>>& targets,
-                                                  const ParticleSet<Dim>& sources,
-                                                  const CubicSplineKernel<Dim>& kernel) {
-  if (relation.rows() != static_cast<Index>(targets.size()) || !relation.options().sorted) {
-    throw SolverError("difference gradient: the relation must have one sorted row per target");
-  }
-  DifferenceGradient<Dim> g;
-  g.row_start.push_back(0);
-  std::vector<Pair<Dim>> pairs;
+void append_difference_row(const Relation<Dim>& relation, Index a, const Vec<Dim>& target,
+                           const ParticleSet<Dim>& sources, const CubicSplineKernel<Dim>& kernel,
+                           std::vector<Pair<Dim>>& pairs, DifferenceGradient<Dim>& g) {
   // A wider relation (a Verlet list with a skin) is cut back to the support.
   const bool filter = relation.options().radius > kernel.support_radius();
   const double r2 = kernel.support_radius() * kernel.support_radius();
-  for (Index a = 0; a < relation.rows(); ++a) {
-    row_pairs(relation, a, targets[static_cast<std::size_t>(a)], sources, pairs);
+  {
+    row_pairs(relation, a, target, sources, pairs);
     if (filter) std::erase_if(pairs, [&](const Pair<Dim>& p) { return p.x_ab.squaredNorm() >= r2; });
     Mat<Dim> A = Mat<Dim>::Zero();
     for (const auto& p : pairs) {
@@ -485,7 +483,41 @@ DifferenceGradient<Dim> build_difference_gradient(const Relation<Dim>& relation,
     g.weight_sum.push_back(sum);
     g.row_start.push_back(static_cast<Index>(g.source.size()));
   }
+}
+
+}  // namespace
+
+template <int Dim>
+DifferenceGradient<Dim> build_difference_gradient(const Relation<Dim>& relation, const std::vector<Vec<Dim>>& targets,
+                                                  const ParticleSet<Dim>& sources,
+                                                  const CubicSplineKernel<Dim>& kernel) {
+  if (relation.rows() != static_cast<Index>(targets.size()) || !relation.options().sorted) {
+    throw SolverError("difference gradient: the relation must have one sorted row per target");
+  }
+  DifferenceGradient<Dim> g;
+  g.row_start.push_back(0);
+  std::vector<Pair<Dim>> pairs;
+  for (Index a = 0; a < relation.rows(); ++a) {
+    append_difference_row(relation, a, targets[static_cast<std::size_t>(a)], sources, kernel, pairs, g);
+  }
   return g;
+}
+
+template <int Dim>
+void build_difference_gradient_rows(const Relation<Dim>& relation, const std::vector<Vec<Dim>>& targets,
+                                    const std::vector<Index>& which, const ParticleSet<Dim>& sources,
+                                    const CubicSplineKernel<Dim>& kernel, DifferenceGradient<Dim>& out) {
+  if (relation.rows() != static_cast<Index>(targets.size()) || !relation.options().sorted) {
+    throw SolverError("difference gradient: the relation must have one sorted row per target");
+  }
+  out.row_start.assign(1, 0);
+  out.source.clear();
+  out.weight.clear();
+  out.weight_sum.clear();
+  std::vector<Pair<Dim>> pairs;
+  for (const Index a : which) {
+    append_difference_row(relation, a, targets[static_cast<std::size_t>(a)], sources, kernel, pairs, out);
+  }
 }
 
 template <int Dim>
@@ -502,14 +534,17 @@ DifferenceGradient<Dim> build_difference_gradient(const std::vector<Vec<Dim>>& t
 #define RKTSPH_INSTANTIATE(D)                                                                                        \
   template RelationOptions operator_relation_options<D>(const CubicSplineKernel<D>&);                                \
   template RelationOptions difference_gradient_relation_options<D>(const CubicSplineKernel<D>&);                     \
+  template void build_difference_gradient_rows<D>(const Relation<D>&, const std::vector<Vec<D>>&,                    \
+                                                  const std::vector<Index>&, const ParticleSet<D>&,                  \
+                                                  const CubicSplineKernel<D>&, DifferenceGradient<D>&);              \
   template CorrectedOperator<D> build_corrected_operator<D>(const Relation<D>&, const std::vector<Vec<D>>&,          \
                                                             const ParticleSet<D>&, const CubicSplineKernel<D>&,      \
                                                             const OperatorOptions&);                                 \
   template CorrectedOperator<D> build_corrected_operator<D>(const std::vector<Vec<D>>&, const ParticleSet<D>&,       \
                                                             const CubicSplineKernel<D>&, const OperatorOptions&);    \
   template void rebuild_corrected_operator<D>(const Relation<D>&, const std::vector<Vec<D>>&, const ParticleSet<D>&, \
-                                              const CubicSplineKernel<D>&, CorrectedOperator<D>&,              \
-                                              const exec::Threads&);                                           \
+                                              const CubicSplineKernel<D>&, CorrectedOperator<D>&,                    \
+                                              const exec::Threads&);                                                 \
   template DifferenceGradient<D> build_difference_gradient<D>(const Relation<D>&, const std::vector<Vec<D>>&,        \
                                                               const ParticleSet<D>&, const CubicSplineKernel<D>&);   \
   template DifferenceGradient<D> build_difference_gradient<D>(const std::vector<Vec<D>>&, const std::vector<Index>&, \

@@ -24,9 +24,9 @@
 #include <cstddef>
 #include <vector>
 
+#include "core/execution.hpp"
 #include "core/kernel.hpp"
 #include "core/types.hpp"
-#include "core/execution.hpp"
 #include "neighbours/relation.hpp"
 #include "particles/particle_set.hpp"
 
@@ -135,6 +135,12 @@ DifferenceGradient<Dim> build_difference_gradient(const Relation<Dim>& relation,
                                                   const ParticleSet<Dim>& sources,
                                                   const CubicSplineKernel<Dim>& kernel);
 /// The same at the selected targets (one row per entry of `which`), with the relation built here.
+/// The difference gradient at the targets of the rows `which` of `relation` (one sorted row per
+/// target, a wider Verlet list cut back to the support), in the order of `which`.
+template <int Dim>
+void build_difference_gradient_rows(const Relation<Dim>& relation, const std::vector<Vec<Dim>>& targets,
+                                    const std::vector<Index>& which, const ParticleSet<Dim>& sources,
+                                    const CubicSplineKernel<Dim>& kernel, DifferenceGradient<Dim>& out);
 template <int Dim>
 DifferenceGradient<Dim> build_difference_gradient(const std::vector<Vec<Dim>>& targets, const std::vector<Index>& which,
                                                   const ParticleSet<Dim>& sources,

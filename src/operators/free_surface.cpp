@@ -31,8 +31,8 @@ template <int Dim>
 void detect_free_surface(const ParticleSet<Dim>& set, const Relation<Dim>& relation,
                          const CubicSplineKernel<Dim>& kernel, const FreeSurfaceOptions& options,
                          const std::vector<std::uint8_t>& previous, const std::vector<std::uint8_t>& excluded,
-                         std::vector<std::uint8_t>& flags, std::vector<Vec<Dim>>& normals,
-                         const exec::Threads& policy) {
+                         std::vector<std::uint8_t>& flags, std::vector<Vec<Dim>>& normals, const exec::Threads& policy,
+                         std::vector<std::uint8_t>* corners) {
   const Index n = set.size();
   const double h = kernel.h();
   const double r2 = kernel.support_radius() * kernel.support_radius();
@@ -112,26 +112,66 @@ void detect_free_surface(const ParticleSet<Dim>& set, const Relation<Dim>& relat
     }
     flags.swap(keep);
   }
-  // Step 4 (2D): the improved normal, from the perpendiculars to the chords to the surface
-  // neighbours, each turned to the first normal's side.
+  // Step 4 (2D): the improved normal, from the chords to the two adjacent surface nodes: the
+  // nearest partner on either side along the tangent of the first normal, a partner being a
+  // flagged neighbour or an excluded one that is not plainly interior (a wall's surface node,
+  // where the free surface meets a wall). Each chord's perpendicular is turned to the first
+  // normal's side; their mean is the normal. Where the two perpendiculars differ by more than
+  // kCornerTurn the node is a corner: two faces meet there and no single normal holds.
+  if (corners != nullptr) corners->assign(static_cast<std::size_t>(n), 0);
   if constexpr (Dim == 2) {
+    const double corner_cos = std::cos(kCornerTurn);
     std::vector<Vec<Dim>> improved(normals);
     exec::particle_for(policy, n, [&](Index i) {
       const auto iu = static_cast<std::size_t>(i);
       if (flags[iu] == 0) return;
-      Vec<Dim> sum = Vec<Dim>::Zero();
+      const Vec<Dim> n0 = normals[iu];
+      const Vec<Dim> tangent(-n0[1], n0[0]);
+      double best[2] = {r2, r2};
+      Vec<Dim> chord[2] = {Vec<Dim>::Zero(), Vec<Dim>::Zero()};
       for (const Index j : relation.row(i)) {
         const auto ju = static_cast<std::size_t>(j);
-        if (j == i || flags[ju] == 0) continue;
+        if (j == i) continue;
+        const bool partner =
+            flags[ju] != 0 || (!excluded.empty() && excluded[ju] != 0 && lambda[ju] <= options.interior_above);
+        if (!partner) continue;
         const Vec<Dim> c = set.position[ju] - set.position[iu];
-        if (c.squaredNorm() >= r2) continue;
-        Vec<Dim> p(-c[1], c[0]);
-        if (p.dot(normals[iu]) < 0.0) p = -p;
-        sum += p;
+        const double d2 = c.squaredNorm();
+        const double along = tangent.dot(c);
+        if (along == 0.0) continue;
+        const int side = along > 0.0 ? 0 : 1;
+        if (d2 < best[side]) {
+          best[side] = d2;
+          chord[side] = c;
+        }
       }
+      Vec<Dim> p[2];
+      int found = 0;
+      for (int side = 0; side < 2; ++side) {
+        if (chord[side].squaredNorm() == 0.0) continue;
+        Vec<Dim> q(-chord[side][1], chord[side][0]);
+        if (q.dot(n0) < 0.0) q = -q;
+        p[found++] = q.normalized();
+      }
+      if (found == 0) return;
+      const Vec<Dim> sum = found == 2 ? Vec<Dim>(p[0] + p[1]) : p[0];
       if (sum.norm() > 0.0) improved[iu] = sum / sum.norm();
+      if (found == 2 && corners != nullptr && p[0].dot(p[1]) < corner_cos) (*corners)[iu] = 1;
     });
     normals.swap(improved);
+  }
+}
+
+template <int Dim>
+void make_corner_traction_free(double* s) {
+  // Two traction-free faces through the point: sigma n1 = sigma n2 = 0 with n1, n2 independent
+  // leaves no in-plane stress (the out-of-plane sigma_zz is kept, as for a face).
+  if constexpr (Dim == 2) {
+    s[stress_slot<Dim>(0, 0)] = 0.0;
+    s[stress_slot<Dim>(1, 1)] = 0.0;
+    s[stress_slot<Dim>(0, 1)] = 0.0;
+  } else {
+    static_cast<void>(s);
   }
 }
 
@@ -154,12 +194,13 @@ void make_traction_free(const Vec<Dim>& n, double* s) {
   }
 }
 
-#define RKTSPH_INSTANTIATE(D)                                                                                 \
-  template void detect_free_surface<D>(const ParticleSet<D>&, const Relation<D>&, const CubicSplineKernel<D>&, \
-                                       const FreeSurfaceOptions&, const std::vector<std::uint8_t>&,          \
-                                       const std::vector<std::uint8_t>&, std::vector<std::uint8_t>&,         \
-                                       std::vector<Vec<D>>&, const exec::Threads&);                           \
-  template void make_traction_free<D>(const Vec<D>&, double*);
+#define RKTSPH_INSTANTIATE(D)                                                                                   \
+  template void detect_free_surface<D>(const ParticleSet<D>&, const Relation<D>&, const CubicSplineKernel<D>&,  \
+                                       const FreeSurfaceOptions&, const std::vector<std::uint8_t>&,             \
+                                       const std::vector<std::uint8_t>&, std::vector<std::uint8_t>&,            \
+                                       std::vector<Vec<D>>&, const exec::Threads&, std::vector<std::uint8_t>*); \
+  template void make_traction_free<D>(const Vec<D>&, double*);                                                  \
+  template void make_corner_traction_free<D>(double*);
 RKTSPH_INSTANTIATE(1)
 RKTSPH_INSTANTIATE(2)
 RKTSPH_INSTANTIATE(3)

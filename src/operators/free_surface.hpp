@@ -7,7 +7,8 @@
 //   3. candidates: the umbrella scan of Marrone et al. about T = x_I + h n_I (2D: the square
 //      test within sqrt(2) h, 3D: a cone of half-angle pi/4), any neighbour inside it making the
 //      node interior;
-//   4. 2D: the improved normal, from the perpendiculars to the chords to the surface neighbours;
+//   4. 2D: the improved normal, from the perpendiculars to the chords to the two adjacent surface
+//      nodes (one on either side); a corner where those two differ by more than kCornerTurn;
 //   5. temporal coherence: a node that was not on the surface may become one only next to a
 //      node that was, or with lambda_I <= surface_below (a genuinely new surface);
 //   6. nodes excluded by the caller (explicit boundary conditions) are never flagged.
@@ -21,6 +22,13 @@
 
 namespace rktsph {
 
+/// The turn between the two chords at a surface node above which it is a corner (2D), rad. A
+/// face cut from the lattice (a slope, a curve) is a staircase whose chords turn by 45 degrees
+/// at each step; those are not corners, so the threshold lies between that and the 90 degrees
+/// of a block's corner. A genuine obtuse crest (a 45 degree slope's, turning by 45 degrees) is
+/// then treated as a face with the bisecting normal.
+inline constexpr double kCornerTurn = 1.0471975511965976;  // 60 degrees
+
 struct FreeSurfaceOptions {
   double surface_below = 0.2;    // lambda_min of B at or below which a node is on the surface
   double interior_above = 0.75;  // lambda_min above which it is interior without the scan
@@ -30,17 +38,31 @@ struct FreeSurfaceOptions {
 /// `relation` (the set's own neighbours within the support; a wider Verlet list is cut back).
 /// `previous` (may be empty) holds the flags of the last step for the temporal coherence;
 /// `excluded` (may be empty) the particles never flagged. Normals are zero off the surface.
+/// `corners`, if given, gets 1 at the surface nodes where two faces meet (2D; see step 4).
 template <int Dim>
 void detect_free_surface(const ParticleSet<Dim>& set, const Relation<Dim>& relation,
                          const CubicSplineKernel<Dim>& kernel, const FreeSurfaceOptions& options,
                          const std::vector<std::uint8_t>& previous, const std::vector<std::uint8_t>& excluded,
                          std::vector<std::uint8_t>& flags, std::vector<Vec<Dim>>& normals,
-                         const exec::Threads& policy = {});
+                         const exec::Threads& policy = {}, std::vector<std::uint8_t>* corners = nullptr);
 
 /// Traction-free stress by rotation to the local frame (method-notes §3.7): sigma.n = 0 with the
 /// tangential stress kept, sigma <- sigma - (sigma n) (x) n - n (x) (sigma n) + (n.sigma n) n (x) n;
 /// the out-of-plane sigma_zz is kept in 2D.
 template <int Dim>
 void make_traction_free(const Vec<Dim>& n, double* stress);
+
+/// Traction-free on two faces through a corner (2D): no in-plane stress, sigma_zz kept.
+template <int Dim>
+void make_corner_traction_free(double* stress);
+
+/// The surface condition of a node: the corner's, or the face's about n.
+template <int Dim>
+void make_surface_traction_free(const Vec<Dim>& n, bool corner, double* stress) {
+  if (corner)
+    make_corner_traction_free<Dim>(stress);
+  else
+    make_traction_free<Dim>(n, stress);
+}
 
 }  // namespace rktsph

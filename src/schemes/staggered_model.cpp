@@ -189,9 +189,9 @@ void StaggeredModel<Dim>::set_initial_state() {
   const auto nn = nodes.size();
   const int vertical = Dim - 1;  // the last axis points up
   const double g = setup.gravity.norm();
-  double surface = -std::numeric_limits<double>::infinity();
-  for (const auto& x : nodes.position) surface = std::max(surface, x[vertical]);
-  if (setup.surface_level) surface = *setup.surface_level;
+  double surface_level = -std::numeric_limits<double>::infinity();
+  for (const auto& x : nodes.position) surface_level = std::max(surface_level, x[vertical]);
+  if (setup.surface_level) surface_level = *setup.surface_level;
   auto v = nodes.view(fields.velocity);
   auto s = nodes.view(fields.stress);
   auto k = nodes.view(fields.history);
@@ -210,7 +210,7 @@ void StaggeredModel<Dim>::set_initial_state() {
       // method-notes §4.2 option A: sigma_v = -rho g (H - z), lateral = K0 sigma_v.
       const double nu = materials[m].elastic().nu;
       const double k0 = setup.k0.value_or(nu / (1.0 - nu));
-      const double sv = -nodes.density[iu] * g * (surface - nodes.position[iu][vertical]);
+      const double sv = -nodes.density[iu] * g * (surface_level - nodes.position[iu][vertical]);
       for (int n = 0; n < 3; ++n) s(i, n) = (n == vertical ? 1.0 : k0) * sv;
     } else if (setup.initial_stress == InitialStressKind::uniform) {
       from_sym6<Dim>(setup.uniform_stress, s[i]);

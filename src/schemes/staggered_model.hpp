@@ -79,6 +79,15 @@ class StaggeredModel {
   NodalConstraints<Dim> constraints;
   /// Stress points -> constrained nodes, in the difference form (method-notes §0.3 item 1 fix (a)).
   DifferenceGradient<Dim> constrained_gradient;
+  /// V2's detected free surface (schemes/v2_stages.hpp), empty otherwise: each node's row or -1,
+  /// and per row the outward normal and the difference gradient from the stress points, with
+  /// which step 2 sees the traction-free condition (method-notes §3.7, fix (a) of §0.3 item 1).
+  struct SurfaceRows {
+    std::vector<Index> row;
+    std::vector<Vec<Dim>> normal;
+    std::vector<std::uint8_t> corner;  // 1: two faces meet there (method-notes §3.6)
+    DifferenceGradient<Dim> gradient;
+  } surface;
   SourceRuns node_sources, stress_point_sources;
 
   double dx() const { return setup.dx; }

@@ -1,5 +1,7 @@
 #include "schemes/staggered_stages.hpp"
 
+#include "operators/free_surface.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <utility>
@@ -196,6 +198,45 @@ NodeFullStep<Dim, Motion, Velocity>::NodeFullStep(StaggeredModel<Dim>& model,
                                                   std::shared_ptr<ViscoplasticSources<Dim>> sources)
     : m_(model), sources_(std::move(sources)) {}
 
+namespace {
+
+// The stress gradient at a detected free-surface node (V2): sigma = P(sigma) + Q(sigma), with P
+// the traction-free projection of method-notes §3.7 about the node's normal (at a corner: no
+// in-plane stress) and Q = 1 - P the
+// part that the condition prescribes (zero). As fix (a) of §0.3 item 1 does for a prescribed
+// component, Q enters through the difference form with fhat = 0, P through the corrected
+// gradient: grad sigma = P(grad_corrected sigma) + Q(sum_b c_b sigma_b).
+template <int Dim>
+void surface_stress_gradient(const typename StaggeredModel<Dim>::SurfaceRows& surface, Index row,
+                             ConstFieldView<double, kStressComponents<Dim>> sp_s,
+                             double (&grad_s)[Dim][kStressComponents<Dim>]) {
+  constexpr int NS = kStressComponents<Dim>;
+  const DifferenceGradient<Dim>& g = surface.gradient;
+  const auto r = static_cast<std::size_t>(row);
+  double sum[Dim][NS] = {};
+  for (Index k = g.row_start[r]; k < g.row_start[r + 1]; ++k) {
+    const double* s = sp_s[g.source[static_cast<std::size_t>(k)]];
+    const Vec<Dim>& w = g.weight[static_cast<std::size_t>(k)];
+    for (int d = 0; d < Dim; ++d) {
+      for (int c = 0; c < NS; ++c) sum[d][c] += w[d] * s[c];
+    }
+  }
+  const Vec<Dim>& n = surface.normal[r];
+  const bool corner = surface.corner[r] != 0;
+  for (int d = 0; d < Dim; ++d) {
+    double p[NS], q[NS];
+    for (int c = 0; c < NS; ++c) {
+      p[c] = grad_s[d][c];
+      q[c] = sum[d][c];
+    }
+    make_surface_traction_free<Dim>(n, corner, p);
+    make_surface_traction_free<Dim>(n, corner, q);  // P(sum); Q(sum) = sum - P(sum)
+    for (int c = 0; c < NS; ++c) grad_s[d][c] = p[c] + (sum[d][c] - q[c]);
+  }
+}
+
+}  // namespace
+
 template <int Dim, class Motion, class Velocity>
 void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
   constexpr int NS = kStressComponents<Dim>;
@@ -272,6 +313,9 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
                 }
               }
             }
+          }
+          if (!m_.surface.row.empty() && m_.surface.row[iu] >= 0) {
+            surface_stress_gradient<Dim>(m_.surface, m_.surface.row[iu], sp_s, grad_s);
           }
           const int mat = nodes.material[iu];
           double dv[Dim], dsig[NS];
@@ -387,7 +431,7 @@ void VelocityFilter<Dim>::run(const StepContext&) {
   });
 }
 
-#define RKTSPH_INSTANTIATE(D)                                                  \
+#define RKTSPH_INSTANTIATE(D)                                                 \
   template class ViscoplasticSources<D>;                                      \
   template class StressPointHalfStep<D, NoPressureGradient>;                  \
   template class StressPointHalfStep<D, PorePressureGradient<D>>;             \

@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <chrono>
 
+#include "io/state_archive.hpp"
 #include "operators/corrected_operator.hpp"
+#include "operators/free_surface.hpp"
 
 namespace rktsph {
 
@@ -89,10 +91,12 @@ void DetectFreeSurface<Dim>::run(const StepContext&) {
   auto flag = m_.nodes.view(flag_field_);
   auto normal = m_.nodes.view(normal_field_);
   const auto nn = static_cast<std::size_t>(m_.nodes.size());
-  previous_.resize(nn);
-  for (std::size_t i = 0; i < nn; ++i) previous_[i] = flag(i, 0) != 0.0 ? 1 : 0;
+  // The temporal coherence needs a last step: the first detection runs without it.
+  previous_.resize(detections_ > 0 ? nn : 0);
+  for (std::size_t i = 0; i < previous_.size(); ++i) previous_[i] = flag(i, 0) != 0.0 ? 1 : 0;
+  ++detections_;
   detect_free_surface<Dim>(m_.nodes, rebuild_.node_neighbours(), m_.kernel, FreeSurfaceOptions{}, previous_, excluded_,
-                           flags_, normals_, m_.policy);
+                           flags_, normals_, m_.policy, &corners_);
   surface_.clear();
   for (std::size_t i = 0; i < nn; ++i) {
     flag(i, 0) = flags_[i];
@@ -100,14 +104,40 @@ void DetectFreeSurface<Dim>::run(const StepContext&) {
     if (flags_[i] != 0) surface_.push_back(static_cast<Index>(i));
   }
   surface_nodes_ = static_cast<Index>(surface_.size());
-  make_surface_traction_free();
+  // Step 2 sees sigma.n = 0 through the difference form (NodeFullStep).
+  auto& rows = m_.surface;
+  rows.row.assign(nn, -1);
+  rows.normal.clear();
+  rows.corner.clear();
+  for (std::size_t k = 0; k < surface_.size(); ++k) {
+    const auto i = static_cast<std::size_t>(surface_[k]);
+    rows.row[i] = static_cast<Index>(k);
+    rows.normal.push_back(normals_[i]);
+    rows.corner.push_back(corners_[i]);
+  }
+  build_difference_gradient_rows<Dim>(rebuild_.stress_points_of_nodes(), m_.nodes.position, surface_, m_.stress_points,
+                                      m_.kernel, rows.gradient);
+  reapply_traction_free();
   seconds_ += since(t0);
 }
 
 template <int Dim>
-void DetectFreeSurface<Dim>::make_surface_traction_free() {
+void DetectFreeSurface<Dim>::save(io::StateArchive& a, const std::string& prefix) const {
+  a.put_integer(prefix + "detections", detections_);
+}
+
+template <int Dim>
+void DetectFreeSurface<Dim>::load(const io::StateArchive& a, const std::string& prefix) {
+  detections_ = a.integer(prefix + "detections");
+}
+
+template <int Dim>
+void DetectFreeSurface<Dim>::reapply_traction_free() {
   auto stress = m_.nodes.view(m_.fields.stress);
-  for (const Index i : surface_) make_traction_free<Dim>(normals_[static_cast<std::size_t>(i)], stress[i]);
+  for (const Index i : surface_) {
+    const auto iu = static_cast<std::size_t>(i);
+    rktsph::make_surface_traction_free<Dim>(normals_[iu], corners_[iu] != 0, stress[i]);
+  }
 }
 
 template class RebuildOperators<1>;

@@ -37,6 +37,8 @@ class RebuildOperators final : public Stage {
   /// The nodes' own Verlet neighbours (within the support plus the skin), for free-surface
   /// detection; empty unless the case detects its free surface.
   const Relation<Dim>& node_neighbours() const { return node_neighbours_; }
+  /// The stress points near each node (Verlet), for the surface nodes' difference gradient.
+  const Relation<Dim>& stress_points_of_nodes() const { return to_nodes_; }
   std::vector<std::pair<std::string, double>> report() const override {
     return {{"neighbour_searches", static_cast<double>(relation_builds_)},
             {"neighbour_search_seconds", relation_seconds_},
@@ -62,7 +64,8 @@ class RebuildOperators final : public Stage {
 /// (§3.7) before the stress points read it. Nodes that a boundary entry selects are never
 /// flagged: their conditions are the entry's (and the lattice face's, which they stay on). The
 /// flags are a particle field ("free_surface", 1 on the surface) saved in checkpoints, as the
-/// next detection's temporal coherence reads them; "normal" holds the outward normals.
+/// next detection's temporal coherence reads them (the first detection has none); "normal"
+/// holds the outward normals.
 template <int Dim>
 class DetectFreeSurface final : public Stage {
  public:
@@ -70,10 +73,13 @@ class DetectFreeSurface final : public Stage {
   std::string_view name() const override { return "free_surface"; }
   void run(const StepContext& context) override;
   std::size_t scratch_bytes() const override {
-    return previous_.capacity() + flags_.capacity() + excluded_.capacity() + normals_.capacity() * sizeof(Vec<Dim>);
+    return previous_.capacity() + flags_.capacity() + excluded_.capacity() + corners_.capacity() +
+           normals_.capacity() * sizeof(Vec<Dim>);
   }
+  void save(io::StateArchive& archive, const std::string& prefix) const override;
+  void load(const io::StateArchive& archive, const std::string& prefix) override;
   /// sigma.n = 0 at the flagged nodes with the normals of the last detection.
-  void make_surface_traction_free();
+  void reapply_traction_free();
   std::vector<std::pair<std::string, double>> report() const override {
     return {{"surface_nodes_last_step", static_cast<double>(surface_nodes_)}, {"detection_seconds", seconds_}};
   }
@@ -83,10 +89,11 @@ class DetectFreeSurface final : public Stage {
   const RebuildOperators<Dim>& rebuild_;
   Field<double, 1> flag_field_;
   Field<double, Dim> normal_field_;
-  std::vector<std::uint8_t> previous_, flags_, excluded_;
+  std::vector<std::uint8_t> previous_, flags_, excluded_, corners_;
   std::vector<Vec<Dim>> normals_;
   std::vector<Index> surface_;  // the flagged nodes
   Index surface_nodes_ = 0;
+  std::int64_t detections_ = 0;
   double seconds_ = 0.0;
 };
 
@@ -98,7 +105,7 @@ class SurfaceTractionFree final : public Stage {
  public:
   explicit SurfaceTractionFree(DetectFreeSurface<Dim>& detect) : detect_(detect) {}
   std::string_view name() const override { return "surface_traction_free"; }
-  void run(const StepContext&) override { detect_.make_surface_traction_free(); }
+  void run(const StepContext&) override { detect_.reapply_traction_free(); }
 
  private:
   DetectFreeSurface<Dim>& detect_;

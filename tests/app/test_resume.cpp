@@ -298,8 +298,11 @@ TEST(Resume, KillNineNeverLeavesUnreadableOutput) {
   };
   ASSERT_EQ(wait_status(spawn(command(dir.file("ref")))), 0);
   for (int k = 0; k < 20; ++k) {
+    // The last one is killed after a checkpoint of its own, to resume from it below: its folder
+    // starts empty, so that a checkpoint left by an earlier kill is not taken for one.
+    if (k == 19) fs::remove_all(dir.path() / "run");
     const pid_t pid = spawn(command(dir.file("run")));
-    if (k == 19) {  // the last one after a checkpoint, to resume from it below
+    if (k == 19) {
       const auto t0 = std::chrono::steady_clock::now();
       while (!fs::exists(dir.path() / "run" / "checkpoint" / "checkpoint.h5") &&
              std::chrono::steady_clock::now() - t0 < std::chrono::seconds(60)) {

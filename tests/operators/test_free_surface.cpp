@@ -31,12 +31,13 @@ Cloud lattice_cloud(double dx, int n, Keep&& keep) {
   return c;
 }
 
-std::vector<std::uint8_t> flags_of(const Cloud& c, std::vector<Vec<2>>& normals, double dx) {
+std::vector<std::uint8_t> flags_of(const Cloud& c, std::vector<Vec<2>>& normals, double dx,
+                                   std::vector<std::uint8_t>* corners = nullptr) {
   const CubicSplineKernel<2> kernel(1.2 * dx);
   Relation<2> rel;
   rel.build(c.set.position, c.set.position, {kernel.support_radius(), 1, true});
   std::vector<std::uint8_t> flags;
-  detect_free_surface<2>(c.set, rel, kernel, {}, {}, {}, flags, normals);
+  detect_free_surface<2>(c.set, rel, kernel, {}, {}, {}, flags, normals, exec::Threads{}, corners);
   return flags;
 }
 
@@ -46,24 +47,35 @@ TEST(FreeSurface, TheFlagsOfASquareAreItsFaceNodesExactly) {
   const double dx = 0.1;
   const Cloud c = lattice_cloud(dx, 10, [](const Vec<2>&) { return true; });
   std::vector<Vec<2>> normals;
-  const auto flags = flags_of(c, normals, dx);
+  std::vector<std::uint8_t> corners;
+  const auto flags = flags_of(c, normals, dx, &corners);
   for (Index i = 0; i < c.set.size(); ++i) {
-    const auto& x = c.set.position[static_cast<std::size_t>(i)];
-    const bool face = std::abs(std::abs(x[0]) - 1.0) < 1e-9 || std::abs(std::abs(x[1]) - 1.0) < 1e-9;
-    EXPECT_EQ(flags[static_cast<std::size_t>(i)] != 0, face) << "node at " << x.transpose();
-    if (face && std::abs(x[1]) < 1.0 - 2.5 * dx) {
-      // A side node away from the corners (whose chords bend it): the face's normal, outward.
-      EXPECT_NEAR(normals[static_cast<std::size_t>(i)][0], x[0] > 0 ? 1.0 : -1.0, 1e-6) << x.transpose();
+    const auto iu = static_cast<std::size_t>(i);
+    const auto& x = c.set.position[iu];
+    const bool side = std::abs(std::abs(x[0]) - 1.0) < 1e-9, top = std::abs(std::abs(x[1]) - 1.0) < 1e-9;
+    EXPECT_EQ(flags[iu] != 0, side || top) << "node at " << x.transpose();
+    // Only the four lattice corners are corners; every other face node, the corners'
+    // neighbours included, gets its face's outward normal exactly (its two chords lie on the face).
+    EXPECT_EQ(corners[iu] != 0, side && top) << "node at " << x.transpose();
+    if (side != top) {
+      const Vec<2> n = side ? Vec<2>(x[0] > 0 ? 1.0 : -1.0, 0.0) : Vec<2>(0.0, x[1] > 0 ? 1.0 : -1.0);
+      EXPECT_NEAR((normals[iu] - n).norm(), 0.0, 1e-12) << x.transpose();
+    }
+    if (side && top) {
+      // The corner's normal bisects it.
+      EXPECT_NEAR(normals[iu].dot(x.normalized()), 1.0, 1e-12) << x.transpose();
     }
   }
   EXPECT_EQ(count(flags), 80);
+  EXPECT_EQ(count(corners), 4);
 }
 
 TEST(FreeSurface, TheFlagsOfADiscAreItsOuterRingWithOutwardNormals) {
   const double dx = 0.1, R = 1.0;
   const Cloud c = lattice_cloud(dx, 12, [&](const Vec<2>& x) { return x.norm() <= R + 1e-9; });
   std::vector<Vec<2>> normals;
-  const auto flags = flags_of(c, normals, dx);
+  std::vector<std::uint8_t> corners;
+  const auto flags = flags_of(c, normals, dx, &corners);
   long missing = 0, wrong = 0;
   for (Index i = 0; i < c.set.size(); ++i) {
     const auto& x = c.set.position[static_cast<std::size_t>(i)];
@@ -72,6 +84,10 @@ TEST(FreeSurface, TheFlagsOfADiscAreItsOuterRingWithOutwardNormals) {
     const bool edge = !has(1, 0) || !has(-1, 0) || !has(0, 1) || !has(0, -1);
     const bool deep = x.norm() < R - 2.0 * dx;  // a full support of material around it
     if (edge && flags[static_cast<std::size_t>(i)] == 0) ++missing;
+    // The staircase of a lattice disc turns by 45 degrees at each step: not a corner. Only the
+    // four one-node bumps on the axes (no lattice neighbour outward or along the face) are.
+    const bool bump = !has(1, 0) + !has(-1, 0) + !has(0, 1) + !has(0, -1) == 3;
+    EXPECT_EQ(corners[static_cast<std::size_t>(i)] != 0, bump) << "node at " << x.transpose();
     if (deep && flags[static_cast<std::size_t>(i)] != 0) ++wrong;
     if (flags[static_cast<std::size_t>(i)] != 0) {
       EXPECT_GT(normals[static_cast<std::size_t>(i)].dot(x.normalized()), 0.9) << "normal at " << x.transpose();
@@ -107,6 +123,21 @@ TEST(FreeSurface, TheTractionFreeRotationZeroesSigmaNAndKeepsTheTangentialStress
   EXPECT_LT((tensor() * n).norm(), 1e-10);
   EXPECT_NEAR(t.dot(tensor() * t), tt0, 1e-9);
   EXPECT_EQ(s[2], -2.0e4);  // sigma_zz kept
+}
+
+TEST(FreeSurface, ACornerIsFreeOfInPlaneStressAndAFaceOfItsNormalTraction) {
+  // Two free faces through a point (normals n1, n2 independent) leave no in-plane stress.
+  double corner[4] = {-3.0e4, -1.0e4, -2.0e4, 5.0e3};
+  make_surface_traction_free<2>(Vec<2>(1.0, 0.0), true, corner);
+  EXPECT_EQ(corner[0], 0.0);
+  EXPECT_EQ(corner[1], 0.0);
+  EXPECT_EQ(corner[3], 0.0);
+  EXPECT_EQ(corner[2], -2.0e4);  // sigma_zz kept
+  double face[4] = {-3.0e4, -1.0e4, -2.0e4, 5.0e3};
+  make_surface_traction_free<2>(Vec<2>(1.0, 0.0), false, face);
+  EXPECT_EQ(face[0], 0.0);
+  EXPECT_EQ(face[3], 0.0);
+  EXPECT_NEAR(face[1], -1.0e4, 1e-9);  // the tangential stress kept
 }
 
 }  // namespace
