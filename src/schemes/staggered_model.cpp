@@ -109,18 +109,19 @@ StaggeredModel<Dim>::StaggeredModel(CaseSetup<Dim> case_setup, exec::Threads thr
   // Fields (the order is the order of the output frames).
   const int history = materials.history.stride();
   const unsigned state = kFieldOutput | kFieldEvolving;
-  fields.velocity = nodes.template add_field<double, Dim>("velocity", axis_names("v", Dim), state, Dim, FieldKind::vector);
+  fields.velocity =
+      nodes.template add_field<double, Dim>("velocity", axis_names("v", Dim), state, Dim, FieldKind::vector);
   fields.displacement =
       nodes.template add_field<double, Dim>("displacement", axis_names("u", Dim), state, Dim, FieldKind::vector);
   fields.stress = nodes.template add_field<double, NS>("stress", stress_names<Dim>(), state, NS, FieldKind::stress);
-  fields.history = nodes.template add_field<double, 0>("history", materials.history.names(), state, history,
-                                                       FieldKind::history);
+  fields.history =
+      nodes.template add_field<double, 0>("history", materials.history.names(), state, history, FieldKind::history);
   fields.sp_velocity =
       stress_points.template add_field<double, Dim>("velocity", axis_names("v", Dim), state, Dim, FieldKind::vector);
   fields.sp_stress =
       stress_points.template add_field<double, NS>("stress", stress_names<Dim>(), state, NS, FieldKind::stress);
-  fields.sp_history = stress_points.template add_field<double, 0>("history", materials.history.names(), state,
-                                                                  history, FieldKind::history);
+  fields.sp_history = stress_points.template add_field<double, 0>("history", materials.history.names(), state, history,
+                                                                  FieldKind::history);
 
   node_sources = make_source_runs(nodes, materials);
   stress_point_sources = make_source_runs(stress_points, materials);
@@ -160,12 +161,16 @@ void StaggeredModel<Dim>::apply_constraints(double t) {
 
 template <int Dim>
 double StaggeredModel<Dim>::boundary_power() const {
-  // Power of the surface tractions: sum over face nodes of A (sigma . n) . v.
+  // Power of the surface tractions: sum over face nodes of A (sigma . n) . v, with the lattice's
+  // area and normal. Where the free surface is detected (V2), a face node that no boundary entry
+  // selects is traction-free in its current frame and does no work; the lattice normal would
+  // count a traction there once the face has turned (a neck).
   const auto v = nodes.view(fields.velocity);
   const auto s = nodes.view(fields.stress);
   double power = 0.0;
   for (std::size_t b = 0; b < boundary.size(); ++b) {
     const Index i = boundary.node[b];
+    if (setup.detect_free_surface && constraints.begin(i) == constraints.end(i)) continue;
     const std::uint8_t faces = boundary.faces[b];
     for (int d = 0; d < Dim; ++d) {
       for (int side = 0; side < 2; ++side) {
