@@ -12,29 +12,14 @@
 #include "core/error.hpp"
 #include "core/execution.hpp"
 #include "neighbours/cell_list.hpp"
+#include "operators/row_pairs.hpp"
 
 namespace rktsph {
 
+using detail::Pair;
+using detail::row_pairs;
+
 namespace {
-
-template <int Dim>
-struct Pair {
-  Index b;
-  Vec<Dim> x_ab;  // x_a - x_b
-  double r;
-};
-
-// The pairs of row a of a relation (sources in row order), with x_a - x_b and the distance.
-template <int Dim>
-void row_pairs(const Relation<Dim>& relation, Index a, const Vec<Dim>& xa, const ParticleSet<Dim>& sources,
-               std::vector<Pair<Dim>>& pairs) {
-  const auto row = relation.row(a);
-  pairs.resize(row.size());
-  for (std::size_t k = 0; k < row.size(); ++k) {
-    const Vec<Dim> x_ab = xa - sources.position[static_cast<std::size_t>(row[k])];
-    pairs[k] = {row[k], x_ab, std::sqrt(x_ab.squaredNorm())};
-  }
-}
 
 // Rows are assembled in fixed blocks: each block finds its own patterns (in parallel), then the
 // blocks are merged in order. The patterns, and so the weights every row ends up with, are
@@ -443,100 +428,8 @@ void rebuild_corrected_operator(const Relation<Dim>& candidates, const std::vect
   op.degenerate_rows = degenerate;
 }
 
-template <int Dim>
-RelationOptions difference_gradient_relation_options(const CubicSplineKernel<Dim>& kernel) {
-  return {kernel.support_radius(), 1, true};
-}
-
-namespace {
-
-// Append the difference-gradient row of target a (row a of the relation) to g.
-template <int Dim>
-void append_difference_row(const Relation<Dim>& relation, Index a, const Vec<Dim>& target,
-                           const ParticleSet<Dim>& sources, const CubicSplineKernel<Dim>& kernel,
-                           std::vector<Pair<Dim>>& pairs, DifferenceGradient<Dim>& g) {
-  // A wider relation (a Verlet list with a skin) is cut back to the support.
-  const bool filter = relation.options().radius > kernel.support_radius();
-  const double r2 = kernel.support_radius() * kernel.support_radius();
-  {
-    row_pairs(relation, a, target, sources, pairs);
-    if (filter) std::erase_if(pairs, [&](const Pair<Dim>& p) { return p.x_ab.squaredNorm() >= r2; });
-    Mat<Dim> A = Mat<Dim>::Zero();
-    for (const auto& p : pairs) {
-      const double V = sources.volume[static_cast<std::size_t>(p.b)];
-      A += V * kernel.gradient(p.x_ab) * (-p.x_ab).transpose();
-    }
-    // method-notes §3.2: A_a = sum V_b grad_a W_ab (x) (x_b - x_a); fall back to the identity
-    // when it is singular. A is O(1) for a reasonable support; a tiny determinant means too few
-    // sources.
-    const bool ok = std::abs(A.determinant()) > 1e-8;
-    const Mat<Dim> Ainv = ok ? Mat<Dim>(A.inverse()) : Mat<Dim>::Identity();
-    Vec<Dim> sum = Vec<Dim>::Zero();
-    for (const auto& p : pairs) {
-      const double V = sources.volume[static_cast<std::size_t>(p.b)];
-      const Vec<Dim> gw = V * kernel.gradient(p.x_ab);
-      const Vec<Dim> c = Ainv * gw;
-      g.source.push_back(p.b);
-      g.weight.push_back(c);
-      sum += c;
-    }
-    g.weight_sum.push_back(sum);
-    g.row_start.push_back(static_cast<Index>(g.source.size()));
-  }
-}
-
-}  // namespace
-
-template <int Dim>
-DifferenceGradient<Dim> build_difference_gradient(const Relation<Dim>& relation, const std::vector<Vec<Dim>>& targets,
-                                                  const ParticleSet<Dim>& sources,
-                                                  const CubicSplineKernel<Dim>& kernel) {
-  if (relation.rows() != static_cast<Index>(targets.size()) || !relation.options().sorted) {
-    throw SolverError("difference gradient: the relation must have one sorted row per target");
-  }
-  DifferenceGradient<Dim> g;
-  g.row_start.push_back(0);
-  std::vector<Pair<Dim>> pairs;
-  for (Index a = 0; a < relation.rows(); ++a) {
-    append_difference_row(relation, a, targets[static_cast<std::size_t>(a)], sources, kernel, pairs, g);
-  }
-  return g;
-}
-
-template <int Dim>
-void build_difference_gradient_rows(const Relation<Dim>& relation, const std::vector<Vec<Dim>>& targets,
-                                    const std::vector<Index>& which, const ParticleSet<Dim>& sources,
-                                    const CubicSplineKernel<Dim>& kernel, DifferenceGradient<Dim>& out) {
-  if (relation.rows() != static_cast<Index>(targets.size()) || !relation.options().sorted) {
-    throw SolverError("difference gradient: the relation must have one sorted row per target");
-  }
-  out.row_start.assign(1, 0);
-  out.source.clear();
-  out.weight.clear();
-  out.weight_sum.clear();
-  std::vector<Pair<Dim>> pairs;
-  for (const Index a : which) {
-    append_difference_row(relation, a, targets[static_cast<std::size_t>(a)], sources, kernel, pairs, out);
-  }
-}
-
-template <int Dim>
-DifferenceGradient<Dim> build_difference_gradient(const std::vector<Vec<Dim>>& targets, const std::vector<Index>& which,
-                                                  const ParticleSet<Dim>& sources,
-                                                  const CubicSplineKernel<Dim>& kernel) {
-  std::vector<Vec<Dim>> selected;
-  for (Index a : which) selected.push_back(targets[static_cast<std::size_t>(a)]);
-  Relation<Dim> relation;
-  relation.build(selected, sources.position, difference_gradient_relation_options(kernel));
-  return build_difference_gradient(relation, selected, sources, kernel);
-}
-
 #define RKTSPH_INSTANTIATE(D)                                                                                        \
   template RelationOptions operator_relation_options<D>(const CubicSplineKernel<D>&);                                \
-  template RelationOptions difference_gradient_relation_options<D>(const CubicSplineKernel<D>&);                     \
-  template void build_difference_gradient_rows<D>(const Relation<D>&, const std::vector<Vec<D>>&,                    \
-                                                  const std::vector<Index>&, const ParticleSet<D>&,                  \
-                                                  const CubicSplineKernel<D>&, DifferenceGradient<D>&);              \
   template CorrectedOperator<D> build_corrected_operator<D>(const Relation<D>&, const std::vector<Vec<D>>&,          \
                                                             const ParticleSet<D>&, const CubicSplineKernel<D>&,      \
                                                             const OperatorOptions&);                                 \
@@ -544,11 +437,7 @@ DifferenceGradient<Dim> build_difference_gradient(const std::vector<Vec<Dim>>& t
                                                             const CubicSplineKernel<D>&, const OperatorOptions&);    \
   template void rebuild_corrected_operator<D>(const Relation<D>&, const std::vector<Vec<D>>&, const ParticleSet<D>&, \
                                               const CubicSplineKernel<D>&, CorrectedOperator<D>&,                    \
-                                              const exec::Threads&);                                                 \
-  template DifferenceGradient<D> build_difference_gradient<D>(const Relation<D>&, const std::vector<Vec<D>>&,        \
-                                                              const ParticleSet<D>&, const CubicSplineKernel<D>&);   \
-  template DifferenceGradient<D> build_difference_gradient<D>(const std::vector<Vec<D>>&, const std::vector<Index>&, \
-                                                              const ParticleSet<D>&, const CubicSplineKernel<D>&);
+                                              const exec::Threads&);
 RKTSPH_INSTANTIATE(1)
 RKTSPH_INSTANTIATE(2)
 RKTSPH_INSTANTIATE(3)
