@@ -2,14 +2,18 @@
 // central finite differences), overstress functions and hardening laws.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <numbers>
+#include <vector>
 
 #include "materials/hardening.hpp"
 #include "materials/overstress.hpp"
 #include "materials/tensor.hpp"
 #include "materials/yield_cam_clay.hpp"
+#include "materials/yield_drucker_prager.hpp"
 #include "materials/yield_von_mises.hpp"
 
 namespace rktsph {
@@ -162,6 +166,143 @@ TEST(PerzynaParts, CamClayHardeningLaw) {
   CamClayHardening o{1.0, 0.0, 4.0};
   o.initial_state(50e3, k);
   EXPECT_DOUBLE_EQ(k[2], 200e3);
+}
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+// A Drucker–Prager surface as the registry builds it (perzyna_models.cpp), rounding eps.
+DruckerPragerSurface drucker_prager(DruckerPragerMatch match, double phi_deg, double psi_deg, double eps) {
+  const DruckerPragerCone cone = DruckerPragerCone::matched(match, phi_deg * kDeg, psi_deg * kDeg);
+  return {cone.eta, cone.eta_flow, eps * std::sin(phi_deg * kDeg), eps * std::sin(psi_deg * kDeg)};
+}
+
+bool all_finite(const Sym6& a) {
+  return std::all_of(a.begin(), a.end(), [](double v) { return std::isfinite(v); });
+}
+
+TEST(PerzynaParts, DruckerPragerValueGradientAndFlowMatchFiniteDifferences) {
+  const double Y = 30e3;  // xi c, Pa; delta_F = 0.1 sin(30 deg) Y = 1.5 kPa
+  const double p_apex = -Y / drucker_prager(DruckerPragerMatch::plane_strain, 30, 10, 0.1).eta;
+  const std::vector<Sym6> states{
+      kGeneral,
+      {-50e3, -50e3, -50e3, 300.0, 0, 0},                           // near the axis, q = 520 Pa < delta_F
+      {-50e3, -50e3, -50e3, 0, 0, 0},                               // on the axis (q = 0)
+      {p_apex, p_apex, p_apex, 0, 0, 0},                            // at the sharp cone's apex
+      {-3 * p_apex, -3 * p_apex + 100.0, -3 * p_apex, 0, 50.0, 0},  // far beyond the apex, in tension
+  };
+  double worst_grad = 0.0, worst_flow = 0.0;
+  for (DruckerPragerMatch match :
+       {DruckerPragerMatch::plane_strain, DruckerPragerMatch::outer, DruckerPragerMatch::inner}) {
+    const DruckerPragerSurface dp = drucker_prager(match, 30, 10, 0.1);
+    for (std::size_t k = 0; k < states.size(); ++k) {
+      const Sym6& s = states[k];
+      const Sym6 g = dp.gradient(s, Y);
+      const Sym6 fd = fd_gradient([&](const Sym6& t) { return dp.value(t, Y); }, s, 0.5);
+      const Sym6 m = dp.flow(s, Y);
+      const Sym6 fdm = fd_gradient([&](const Sym6& t) { return dp.potential(t, Y); }, s, 0.5);
+      for (std::size_t i = 0; i < 6; ++i) {
+        EXPECT_NEAR(g[i], fd[i], 1e-6 * (1.0 + std::abs(fd[i]))) << "state " << k << " i " << i;
+        EXPECT_NEAR(m[i], fdm[i], 1e-6 * (1.0 + std::abs(fdm[i]))) << "state " << k << " i " << i;
+        worst_grad = std::max(worst_grad, std::abs(g[i] - fd[i]));
+        worst_flow = std::max(worst_flow, std::abs(m[i] - fdm[i]));
+      }
+    }
+  }
+  std::printf("[ figures  ] Drucker-Prager max |dF/dsigma - FD| = %.2e, max |m - dQ/dsigma FD| = %.2e\n", worst_grad,
+              worst_flow);
+  // The flow slope is the potential's, not the surface's (non-associated): tr m = eta_Q.
+  const DruckerPragerSurface dp = drucker_prager(DruckerPragerMatch::plane_strain, 30, 10, 0.1);
+  EXPECT_NEAR(tensor::trace(dp.flow(kGeneral, Y)), dp.eta_flow, 1e-14);
+  EXPECT_NEAR(tensor::trace(dp.gradient(kGeneral, Y)), dp.eta, 1e-14);
+  EXPECT_LT(dp.eta_flow, dp.eta);
+}
+
+// The cone against the Mohr–Coulomb strength of the matched meridian (no rounding): on the
+// compression meridian for the outer cone, the extension meridian for the inner one.
+TEST(PerzynaParts, DruckerPragerMatchesMohrCoulombOnItsMeridian) {
+  const double phi = 30 * kDeg, c = 20e3, sf = std::sin(phi), cf = std::cos(phi);
+  const double confining = 80e3;                                                 // sigma_3, compression positive
+  const double major = confining * (1 + sf) / (1 - sf) + 2 * c * cf / (1 - sf);  // sigma_1 on MC
+  struct Case {
+    DruckerPragerMatch match;
+    Sym6 stress;
+  };
+  const Case cases[] = {
+      {DruckerPragerMatch::outer, {-confining, -major, -confining, 0, 0, 0}},  // triaxial compression
+      {DruckerPragerMatch::inner, {-major, -confining, -major, 0, 0, 0}},      // triaxial extension
+  };
+  for (const Case& k : cases) {
+    const DruckerPragerCone cone = DruckerPragerCone::matched(k.match, phi, 0.0);
+    const DruckerPragerSurface dp{cone.eta, 0.0, 0.0, 0.0};
+    EXPECT_NEAR(dp.value(k.stress, cone.xi * c), cone.xi * c, 1e-9 * cone.xi * c);
+  }
+  // Plane-strain match, associated: the classical sqrt(J2) = k + 3 alpha p' with
+  // alpha = tan(phi)/sqrt(9 + 12 tan^2 phi), k = 3c/sqrt(9 + 12 tan^2 phi); eta = 3 sqrt3 alpha, xi c = sqrt3 k.
+  const DruckerPragerCone ps = DruckerPragerCone::matched(DruckerPragerMatch::plane_strain, phi, phi);
+  const double t = std::tan(phi);
+  EXPECT_NEAR(ps.eta, std::sqrt(3.0) * 3 * t / std::sqrt(9 + 12 * t * t), 1e-14);
+  EXPECT_NEAR(ps.xi, std::sqrt(3.0) * 3 / std::sqrt(9 + 12 * t * t), 1e-14);
+  EXPECT_NEAR(ps.eta_flow, ps.eta, 1e-14);
+  // Plane-strain match with psi = 0: alpha = sin(phi)/3, k = c cos(phi) (sqrt(J2) form).
+  const DruckerPragerCone ps0 = DruckerPragerCone::matched(DruckerPragerMatch::plane_strain, phi, 0.0);
+  EXPECT_NEAR(ps0.eta, std::sqrt(3.0) * sf, 1e-14);
+  EXPECT_NEAR(ps0.xi, std::sqrt(3.0) * cf, 1e-14);
+  EXPECT_EQ(ps0.eta_flow, 0.0);
+  // phi = 0: von Mises with Y = sqrt(3) c (plane strain) or 2 c (through the Tresca corners).
+  EXPECT_NEAR(DruckerPragerCone::matched(DruckerPragerMatch::plane_strain, 0, 0).xi, std::sqrt(3.0), 1e-15);
+  EXPECT_NEAR(DruckerPragerCone::matched(DruckerPragerMatch::outer, 0, 0).xi, 2.0, 1e-15);
+  EXPECT_NEAR(DruckerPragerCone::matched(DruckerPragerMatch::inner, 0, 0).xi, 2.0, 1e-15);
+}
+
+TEST(PerzynaParts, DruckerPragerApexAndTensionStatesAreFinite) {
+  const double Y = 30e3;
+  for (double eps : {0.1, 0.0}) {
+    for (double psi : {0.0, 20.0}) {
+      const DruckerPragerSurface dp = drucker_prager(DruckerPragerMatch::plane_strain, 35, psi, eps);
+      const double p_apex = -Y / dp.eta;
+      for (double p : {0.0, 0.5 * p_apex, p_apex, 10.0 * p_apex, -1e6}) {
+        const Sym6 s{-p, -p, -p, 0, 0, 0};
+        EXPECT_TRUE(std::isfinite(dp.value(s, Y))) << eps << " " << psi << " " << p;
+        EXPECT_TRUE(all_finite(dp.gradient(s, Y))) << eps << " " << psi << " " << p;
+        EXPECT_TRUE(all_finite(dp.flow(s, Y))) << eps << " " << psi << " " << p;
+      }
+      // Unstressed: inside (F = delta_F < Y).
+      EXPECT_LT(dp.value({}, Y), Y);
+      // On the axis the gradient is volumetric, eta/3 1; beyond the apex F > Y.
+      const Sym6 beyond{-2 * p_apex, -2 * p_apex, -2 * p_apex, 0, 0, 0};
+      EXPECT_GT(dp.value(beyond, Y), Y);
+      const Sym6 g = dp.gradient(beyond, Y);
+      EXPECT_NEAR(g[0], dp.eta / 3, 1e-15);
+      EXPECT_EQ(g[3], 0.0);
+      // With psi > 0 the flow there dilates (relieves the tension); with psi = 0 it is zero.
+      const Sym6 m = dp.flow(beyond, Y);
+      if (psi > 0) {
+        EXPECT_GT(tensor::trace(m), 0.0);
+      } else {
+        EXPECT_EQ(tensor::trace(m), 0.0);
+      }
+    }
+  }
+  // The rounded apex: F(q = 0) = Y at p' = -(1 - eps sin(phi)) Y/eta (eq. 1.10.1).
+  const DruckerPragerSurface dp = drucker_prager(DruckerPragerMatch::outer, 30, 0, 0.1);
+  const double p_round = -(1 - 0.05) * Y / dp.eta;
+  EXPECT_NEAR(dp.value({-p_round, -p_round, -p_round, 0, 0, 0}, Y), Y, 1e-9 * Y);
+}
+
+TEST(PerzynaParts, DruckerPragerWithoutFrictionIsVonMises) {
+  const VonMisesSurface vm;
+  const DruckerPragerSurface dp = drucker_prager(DruckerPragerMatch::plane_strain, 0, 0, 0.1);
+  EXPECT_EQ(dp.eta, 0.0);
+  EXPECT_EQ(dp.round_F, 0.0);
+  for (const Sym6& s : {kGeneral, Sym6{-1e5, -1e5, -1e5, 0, 0, 0}, Sym6{3e4, 0, -2e4, 0, 1e4, 0}}) {
+    EXPECT_NEAR(dp.value(s, 1e5), vm.value(s, 1e5), 1e-15 * vm.value(s, 1e5));
+    const Sym6 g = dp.gradient(s, 1e5), gv = vm.gradient(s, 1e5);
+    const Sym6 m = dp.flow(s, 1e5), mv = vm.flow(s, 1e5);
+    for (std::size_t i = 0; i < 6; ++i) {
+      EXPECT_NEAR(g[i], gv[i], 1e-15);
+      EXPECT_NEAR(m[i], mv[i], 1e-15);
+    }
+  }
 }
 
 }  // namespace
