@@ -166,7 +166,7 @@ TEST(MaterialPointCase, RunWritesCsvWithTheDocumentedHeader) {
 
 TEST(MaterialPointCase, ExampleCasesLoad) {
   for (const char* name : {"von_mises_shear.toml", "cam_clay_drained_nc.toml", "cam_clay_undrained_nc.toml",
-                           "cam_clay_case3_biaxial.toml"}) {
+                           "cam_clay_case3_biaxial.toml", "drucker_prager_plane_strain.toml"}) {
     const std::string f = std::string(RKTSPH_SOURCE_DIR) + "/cases/material_point/" + name;
     EXPECT_NO_THROW(load_material_point_case(f, {})) << name;
   }
