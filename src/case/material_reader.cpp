@@ -134,8 +134,9 @@ double read_friction_angle(const io::Section& s) {
   return deg * std::numbers::pi / 180.0;
 }
 
-std::unique_ptr<Material> read_perzyna_drucker_prager(const io::Section& s) {
-  DruckerPragerParameters p;
+// The keys shared by the frictional models (method-notes §1.10–1.11): all but dp_match.
+template <class Parameters>
+void read_frictional(const io::Section& s, Parameters& p) {
   p.elastic = read_elastic_constants(s);
   p.cohesion = s.number("cohesion");
   s.require(p.cohesion > 0.0, "cohesion",
@@ -149,16 +150,6 @@ std::unique_ptr<Material> read_perzyna_drucker_prager(const io::Section& s) {
             fmt::format("the dilatancy angle must lie in [0, {}] degrees (0 <= psi <= the friction angle), got {}",
                         phi_deg, psi_deg));
   p.dilatancy = psi_deg * std::numbers::pi / 180.0;
-  const std::string match = s.string("dp_match", "plane_strain");
-  if (match == "plane_strain") {
-    p.match = DruckerPragerMatch::plane_strain;
-  } else if (match == "outer") {
-    p.match = DruckerPragerMatch::outer;
-  } else if (match == "inner") {
-    p.match = DruckerPragerMatch::inner;
-  } else {
-    s.fail("dp_match", fmt::format("unknown Drucker-Prager match '{}' (known: plane_strain, outer, inner)", match));
-  }
   p.apex_rounding = s.number("apex_rounding", 0.1);
   s.require(p.apex_rounding >= 0.0 && p.apex_rounding < 1.0, "apex_rounding",
             fmt::format("the apex rounding must lie in [0, 1), got {}", p.apex_rounding));
@@ -169,7 +160,28 @@ std::unique_ptr<Material> read_perzyna_drucker_prager(const io::Section& s) {
                         p.residual_cohesion));
   p.fluidity = read_fluidity(s);
   p.overstress = read_overstress(s);
+}
+
+std::unique_ptr<Material> read_perzyna_drucker_prager(const io::Section& s) {
+  DruckerPragerParameters p;
+  read_frictional(s, p);
+  const std::string match = s.string("dp_match", "plane_strain");
+  if (match == "plane_strain") {
+    p.match = DruckerPragerMatch::plane_strain;
+  } else if (match == "outer") {
+    p.match = DruckerPragerMatch::outer;
+  } else if (match == "inner") {
+    p.match = DruckerPragerMatch::inner;
+  } else {
+    s.fail("dp_match", fmt::format("unknown Drucker-Prager match '{}' (known: plane_strain, outer, inner)", match));
+  }
   return make_perzyna_drucker_prager(p);
+}
+
+std::unique_ptr<Material> read_perzyna_mohr_coulomb(const io::Section& s) {
+  MohrCoulombParameters p;
+  read_frictional(s, p);
+  return make_perzyna_mohr_coulomb(p);
 }
 
 struct Entry {
@@ -189,6 +201,9 @@ const std::vector<Entry>& models() {
       {"perzyna_drucker_prager",
        "Perzyna viscoplastic Drucker-Prager (c, phi, dilatancy, rounded apex, c softening; history: eps_vp_eq)",
        read_perzyna_drucker_prager},
+      {"perzyna_mohr_coulomb",
+       "Perzyna viscoplastic Mohr-Coulomb, Abbo-Sloan rounding (c, phi, dilatancy, c softening; history: eps_vp_eq)",
+       read_perzyna_mohr_coulomb},
   };
   return kModels;
 }

@@ -51,4 +51,19 @@ struct DruckerPragerParameters {
 };
 std::unique_ptr<Material> make_perzyna_drucker_prager(const DruckerPragerParameters& parameters);
 
+/// perzyna_mohr_coulomb (method-notes §1.11): Abbo–Sloan rounded pyramid, potential of
+/// dilatancy psi, c = max(c0 + H_c eps_vp_eq, c_residual). The keys of Drucker–Prager but dp_match.
+struct MohrCoulombParameters {
+  ElasticConstants elastic;
+  double cohesion = 0.0;           // c0, Pa, > 0
+  double friction_angle = 0.0;     // phi, radians, in [0, pi/2)
+  double dilatancy = 0.0;          // psi, radians, in [0, phi]
+  double apex_rounding = 0.1;      // eps of delta = eps sin(angle) Y, in [0, 1)
+  double hardening_modulus = 0.0;  // H_c = dc/d eps_vp_eq, Pa (negative: softening)
+  double residual_cohesion = 0.0;  // floor of c, Pa, in (0, c0]
+  double fluidity = 0.0;           // gamma, 1/s
+  Overstress overstress;
+};
+std::unique_ptr<Material> make_perzyna_mohr_coulomb(const MohrCoulombParameters& parameters);
+
 }  // namespace rktsph

@@ -57,11 +57,11 @@ struct DruckerPragerSurface {
   }
 
   /// dF/dsigma = 3 s / (2 sqrt(q^2 + delta_F^2)) + (eta/3) 1, tensor components (eq. 1.10.2).
-  Sym6 gradient(const Sym6& sigma, double Y) const { return cone_gradient(sigma, round_F * Y, eta); }
+  Sym6 gradient(const Sym6& sigma, double Y) const { return cone_gradient(sigma, Y, round_F * Y, eta); }
 
   /// m = dQ/dsigma (eq. 1.10.4): its deviatoric part has sqrt(2/3 e:e) = q/sqrt(q^2 + delta_Q^2),
   /// 1 away from the apex, as for von Mises.
-  Sym6 flow(const Sym6& sigma, double Y) const { return cone_gradient(sigma, round_Q * Y, eta_flow); }
+  Sym6 flow(const Sym6& sigma, double Y) const { return cone_gradient(sigma, Y, round_Q * Y, eta_flow); }
 
   /// The potential Q of eq. (1.10.3), for the tests.
   double potential(const Sym6& sigma, double Y) const {
@@ -71,12 +71,16 @@ struct DruckerPragerSurface {
   }
 
  private:
-  // Gradient of sqrt(q^2 + delta^2) − slope p′. With delta = 0 (phi or psi = 0) at q = 0 the
-  // deviatoric direction is undefined; its part is set to zero there (as for von Mises).
-  static Sym6 cone_gradient(const Sym6& sigma, double delta, double slope) {
+  /// Without rounding, below q = kAxisGuard * Y the deviatoric direction is round-off.
+  static constexpr double kAxisGuard = 1e-9;
+
+  // Gradient of sqrt(q^2 + delta^2) − slope p′. With delta = 0 (phi or psi = 0) on the axis the
+  // deviatoric direction is undefined; its part is set to zero there (no flow for von Mises).
+  static Sym6 cone_gradient(const Sym6& sigma, double Y, double delta, double slope) {
     const Sym6 s = tensor::deviator(sigma);
-    const double root = std::sqrt(1.5 * tensor::ddot(s, s) + delta * delta);
-    Sym6 g = root > 0.0 ? tensor::scaled(s, 1.5 / root) : Sym6{};
+    const double q2 = 1.5 * tensor::ddot(s, s);
+    const bool on_axis = delta == 0.0 && q2 <= kAxisGuard * kAxisGuard * Y * Y;
+    Sym6 g = on_axis ? Sym6{} : tensor::scaled(s, 1.5 / std::sqrt(q2 + delta * delta));
     for (std::size_t i = 0; i < 3; ++i) g[i] += slope / 3.0;
     return g;
   }

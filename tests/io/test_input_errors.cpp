@@ -256,7 +256,8 @@ TEST(InputErrors, UnknownMaterialModelListsKnownModels) {
   const std::string text = replace(kBase, "model = \"elastic\"", "model = \"mohr_coulomb\"");
   const auto o = run_case_text(dir, text);
   expect_error_at(o, line_of(text, "model = "), "material.model",
-                  {"mohr_coulomb", "elastic", "perzyna_von_mises", "perzyna_cam_clay"});
+                  {"mohr_coulomb", "elastic", "perzyna_von_mises", "perzyna_cam_clay", "perzyna_drucker_prager",
+                   "perzyna_mohr_coulomb"});
 }
 
 TEST(InputErrors, FrictionalMaterialOutOfRange) {

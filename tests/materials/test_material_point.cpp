@@ -112,6 +112,22 @@ TEST(MaterialPointCase, BadDruckerPragerInputNamesKeyAndFile) {
   expect_input_error("mp_dp_typo.toml", dp + good + "dilatency = 5\n" + rest, "material.dilatency", "unknown key");
 }
 
+TEST(MaterialPointCase, BadMohrCoulombInputNamesKeyAndFile) {
+  const std::string mc =
+      "[material]\nmodel = 'perzyna_mohr_coulomb'\nE = 1e7\nnu = 0.3\ndensity = 2000\nfluidity = 1\n";
+  const std::string good = "cohesion = 1e4\nfriction_angle = 30\n";
+  const std::string rest = "[path]\ntype = 'simple_shear'\nshear_strain_rate = 1\nduration = 1\n";
+  const auto c = load_material_point_case(write_case("mp_mc_good.toml", mc + good + rest), {});
+  EXPECT_EQ(c.material->model(), "perzyna_mohr_coulomb");
+  expect_input_error("mp_mc_c.toml", mc + "cohesion = -1\nfriction_angle = 30\n" + rest, "material.cohesion");
+  expect_input_error("mp_mc_phi.toml", mc + "cohesion = 1e4\nfriction_angle = 90\n" + rest, "material.friction_angle",
+                     "[0, 90)");
+  expect_input_error("mp_mc_psi.toml", mc + good + "dilatancy = 31\n" + rest, "material.dilatancy",
+                     "the friction angle");
+  // dp_match belongs to Drucker-Prager only.
+  expect_input_error("mp_mc_match.toml", mc + good + "dp_match = 'outer'\n" + rest, "material.dp_match", "unknown key");
+}
+
 TEST(MaterialPointCase, BadPathInputNamesKeyAndFile) {
   expect_input_error("mp_type.toml", kGoodMaterial + "[path]\ntype = 'triaxial'\nduration = 1\n", "path.type",
                      "triaxial");

@@ -14,6 +14,7 @@
 #include "materials/source_integrator.hpp"
 #include "materials/tensor.hpp"
 #include "materials/yield_drucker_prager.hpp"
+#include "materials/yield_mohr_coulomb.hpp"
 
 namespace rktsph {
 namespace {
@@ -579,6 +580,98 @@ TEST(DruckerPragerPerzyna, CohesionSofteningEndsOnTheResidualCone) {
   EXPECT_NEAR(peak_q(r), peak, 1e-2 * peak);
   EXPECT_NEAR(q_of(r.points.back().stress), residual, 2e-3 * residual);
   EXPECT_GT(r.points.back().state[0], 0.04);
+}
+
+// Mohr–Coulomb (Abbo–Sloan), E = 100 MPa, nu = 0.3, c = 10 kPa, default rounding 0.1 (method-notes §1.11).
+std::string mohr_coulomb(double phi, double psi, double fluidity) {
+  return "model = 'perzyna_mohr_coulomb'\nE = 1.0e8\nnu = 0.3\ndensity = 2000.0\ncohesion = 1.0e4\n"
+         "friction_angle = " +
+         std::to_string(phi) + "\ndilatancy = " + std::to_string(psi) + "\nfluidity = " + std::to_string(fluidity) +
+         "\n";
+}
+
+// Drained triaxial compression (theta = +30 deg, p' = p0 + q/3) and extension (theta = -30 deg,
+// p' = p0 - q/3), lateral stress held: the rate-independent peaks of the rounded surface are
+// q = sqrt3 (c cos + p0 sin)/(K(+-1) -+ sin/sqrt3) (method-notes eq. (1.11.6)); the sharp pyramid
+// gives 2 (c cos + p0 sin)/(1 -+ sin).
+TEST(MohrCoulombPerzyna, FastLimitTriaxialPeaks) {
+  const double p0 = 1e5, c = 1e4, phi = 30.0;
+  const double sf = std::sin(phi * kDegree), cf = std::cos(phi * kDegree), r3 = std::sqrt(3.0);
+  const LodeFactor K = LodeFactor::of(sf);
+  double worst_rounded = 0.0, sharp_error[2] = {0.0, 0.0};
+  for (int side = 0; side < 2; ++side) {
+    const double sign = side == 0 ? 1.0 : -1.0;  // compression, extension
+    const double rounded = r3 * (c * cf + p0 * sf) / (K(sign).K - sign * sf / r3);
+    const double sharp = 2.0 * (c * cf + p0 * sf) / (1.0 - sign * sf);
+    for (double psi : {0.0, 30.0}) {
+      auto m = material_from_toml(mohr_coulomb(phi, psi, 20.0));
+      LoadPath path = LoadPath::drained_triaxial(-sign * 0.01);
+      path.duration = 1.0;
+      path.dt = 1e-3;
+      const PathResult r = integrate_path(*m, {-p0, -p0, -p0, 0, 0, 0}, path);
+      const double q = peak_q(r);
+      const double err = std::abs(q - rounded) / rounded;
+      worst_rounded = std::max(worst_rounded, err);
+      sharp_error[side] = std::max(sharp_error[side], std::abs(q - sharp) / sharp);
+      EXPECT_LT(err, 1e-3) << "side " << side << " psi " << psi << ": q " << q << " expected " << rounded;
+      EXPECT_NEAR(q_of(r.points.back().stress), q, 1e-4 * q);
+      // The path stays on its meridian: sigma_yy is the major (compression) or minor principal stress.
+      const Sym6& e = r.points.back().stress;
+      EXPECT_NEAR(e[0], -p0, 1e-6);
+      EXPECT_NEAR(e[2], -p0, 1e-6);
+      EXPECT_NEAR(e[3], 0.0, 1e-9);
+    }
+  }
+  std::printf(
+      "[ figures  ] Mohr-Coulomb triaxial peaks: worst error to the rounded closed form %.2e; to the sharp "
+      "pyramid %.2e (compression), %.2e (extension)\n",
+      worst_rounded, sharp_error[0], sharp_error[1]);
+  // theta_T = 29 deg rounds the corners: the compression peak is 1.5 % below the sharp one at phi = 30.
+  EXPECT_LT(sharp_error[0], 2e-2);
+  EXPECT_LT(sharp_error[1], 3e-3);
+}
+
+// Plane-strain compression (sigma_xx = -p0 held, eps_zz = 0): sigma_zz stays intermediate, on a
+// face of the pyramid (|theta| < theta_T), where the rounded surface is the sharp one, so the
+// peak is eq. (1.10.10) for any dilatancy.
+TEST(MohrCoulombPerzyna, PlaneStrainPeakIsTheMohrCoulombOne) {
+  const double p0 = 1e5, c = 1e4, phi = 30.0;
+  const double sf = std::sin(phi * kDegree), cf = std::cos(phi * kDegree);
+  const double expected = p0 * (1 + sf) / (1 - sf) + 2 * c * cf / (1 - sf);
+  double worst = 0.0;
+  for (double psi : {0.0, 30.0}) {
+    auto m = material_from_toml(mohr_coulomb(phi, psi, 20.0));
+    LoadPath path = LoadPath::plane_strain_compression(-0.01);
+    path.duration = 1.5;
+    path.dt = 1e-3;
+    const PathResult r = integrate_path(*m, {-p0, -p0, -p0, 0, 0, 0}, path);
+    const Sym6& end = r.points.back().stress;
+    const double err = std::abs(-end[1] - expected) / expected;
+    worst = std::max(worst, err);
+    EXPECT_LT(err, 1e-3) << "psi " << psi << ": sigma_yy " << end[1];
+    EXPECT_LT(end[1], end[2]);
+    EXPECT_LT(end[2], end[0]);
+  }
+  std::printf("[ figures  ] Mohr-Coulomb plane-strain peak, worst relative error: %.2e\n", worst);
+}
+
+// phi = 0 in simple shear (theta = 0 throughout): the same path as von Mises with cohesion c.
+TEST(MohrCoulombPerzyna, WithoutFrictionShearsLikeVonMises) {
+  auto mc = material_from_toml(mohr_coulomb(0.0, 0.0, 2.0));
+  auto vm = material_from_toml(
+      "model = 'perzyna_von_mises'\nE = 1.0e8\nnu = 0.3\ndensity = 2000.0\ncohesion = 1.0e4\nfluidity = 2.0\n");
+  LoadPath path = LoadPath::simple_shear(0.02);
+  path.duration = 0.5;
+  path.dt = 1e-3;
+  const Sym6 s0{-1e5, -1e5, -1e5, 0, 0, 0};
+  const PathResult a = integrate_path(*mc, s0, path);
+  const PathResult b = integrate_path(*vm, s0, path);
+  ASSERT_EQ(a.points.size(), b.points.size());
+  for (std::size_t i = 0; i < 6; ++i) {
+    EXPECT_NEAR(a.points.back().stress[i], b.points.back().stress[i], 1e-9 * 1e5) << i;
+  }
+  EXPECT_NEAR(a.points.back().state[0], b.points.back().state[0], 1e-12);
+  EXPECT_GT(a.points.back().state[0], 1e-3);  // it did flow
 }
 
 }  // namespace
