@@ -540,6 +540,30 @@ TEST(DruckerPragerPerzyna, FastLimitDrainedTriaxialPeakMatchesTheCone) {
   std::printf("[ figures  ] Drucker-Prager drained triaxial peak, worst relative error to the cone: %.2e\n", worst);
 }
 
+// Without the apex rounding the only departure from the cone is the overstress, O(1/gamma):
+// the Perzyna peak approaches the rate-independent one as the fluidity grows.
+TEST(DruckerPragerPerzyna, FastLimitConvergesAsOneOverFluidity) {
+  const double p0 = 1e5, c = 1e4;
+  const DruckerPragerCone cone = DruckerPragerCone::matched(DruckerPragerMatch::outer, 30.0 * kDegree, 0.0);
+  const double expected = (cone.eta * p0 + cone.xi * c) / (1.0 - cone.eta / 3.0);
+  double err[2];
+  const double gammas[2] = {5.0, 50.0};
+  for (int i = 0; i < 2; ++i) {
+    auto m = material_from_toml(drucker_prager("outer", 30.0, 0.0, gammas[i], "apex_rounding = 0.0\n"));
+    LoadPath path = LoadPath::drained_triaxial(-0.01);
+    path.duration = 1.0;
+    path.dt = 1e-3;
+    const PathResult r = integrate_path(*m, {-p0, -p0, -p0, 0, 0, 0}, path);
+    err[i] = (q_of(r.points.back().stress) - expected) / expected;
+  }
+  std::printf("[ figures  ] Drucker-Prager peak excess over the cone: %.2e (gamma = 5), %.2e (gamma = 50)\n", err[0],
+              err[1]);
+  EXPECT_GT(err[1], 0.0);  // the overstress is positive
+  EXPECT_LT(err[1], 1e-4);
+  EXPECT_GT(err[0] / err[1], 8.0);
+  EXPECT_LT(err[0] / err[1], 12.0);
+}
+
 // Plane-strain compression (sigma_xx = -p0 held, eps_zz = 0): with the plane-strain match of
 // eq. (1.10.5) the steady peak is the Mohr–Coulomb one, sigma_1 = p0 (1 + sin)/(1 - sin) +
 // 2 c cos/(1 - sin) (compression positive), for any dilatancy (method-notes eq. (1.10.10)).
