@@ -4,6 +4,8 @@
 
 #include <cmath>
 #include <functional>
+#include <numbers>
+#include <string_view>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -124,6 +126,64 @@ std::unique_ptr<Material> read_perzyna_cam_clay(const io::Section& s) {
   return make_perzyna_cam_clay(p);
 }
 
+// The friction angle in degrees, in [0, 90); returned in radians.
+double read_friction_angle(const io::Section& s) {
+  const double deg = s.number("friction_angle");
+  s.require(deg >= 0.0 && deg < 90.0, "friction_angle",
+            fmt::format("the friction angle must lie in [0, 90) degrees, got {}", deg));
+  return deg * std::numbers::pi / 180.0;
+}
+
+// The keys shared by the frictional models (method-notes §1.10–1.11): all but dp_match.
+template <class Parameters>
+void read_frictional(const io::Section& s, Parameters& p) {
+  p.elastic = read_elastic_constants(s);
+  p.cohesion = s.number("cohesion");
+  s.require(p.cohesion > 0.0, "cohesion",
+            fmt::format("the cohesion must be > 0 Pa (Y = xi c normalises the overstress; give a small c "
+                        "for a cohesionless soil), got {}",
+                        p.cohesion));
+  p.friction_angle = read_friction_angle(s);
+  const double phi_deg = s.number("friction_angle");
+  const double psi_deg = s.number("dilatancy", 0.0);
+  s.require(psi_deg >= 0.0 && psi_deg <= phi_deg, "dilatancy",
+            fmt::format("the dilatancy angle must lie in [0, {}] degrees (0 <= psi <= the friction angle), got {}",
+                        phi_deg, psi_deg));
+  p.dilatancy = psi_deg * std::numbers::pi / 180.0;
+  p.apex_rounding = s.number("apex_rounding", 0.1);
+  s.require(p.apex_rounding >= 0.0 && p.apex_rounding < 1.0, "apex_rounding",
+            fmt::format("the apex rounding must lie in [0, 1), got {}", p.apex_rounding));
+  p.hardening_modulus = s.number("hardening_modulus", 0.0);
+  p.residual_cohesion = s.number("residual_cohesion", 0.1 * p.cohesion);
+  s.require(p.residual_cohesion > 0.0 && p.residual_cohesion <= p.cohesion, "residual_cohesion",
+            fmt::format("the residual cohesion must lie in (0, {}] Pa (the initial cohesion), got {}", p.cohesion,
+                        p.residual_cohesion));
+  p.fluidity = read_fluidity(s);
+  p.overstress = read_overstress(s);
+}
+
+std::unique_ptr<Material> read_perzyna_drucker_prager(const io::Section& s) {
+  DruckerPragerParameters p;
+  read_frictional(s, p);
+  const std::string match = s.string("dp_match", "plane_strain");
+  if (match == "plane_strain") {
+    p.match = DruckerPragerMatch::plane_strain;
+  } else if (match == "outer") {
+    p.match = DruckerPragerMatch::outer;
+  } else if (match == "inner") {
+    p.match = DruckerPragerMatch::inner;
+  } else {
+    s.fail("dp_match", fmt::format("unknown Drucker-Prager match '{}' (known: plane_strain, outer, inner)", match));
+  }
+  return make_perzyna_drucker_prager(p);
+}
+
+std::unique_ptr<Material> read_perzyna_mohr_coulomb(const io::Section& s) {
+  MohrCoulombParameters p;
+  read_frictional(s, p);
+  return make_perzyna_mohr_coulomb(p);
+}
+
 struct Entry {
   const char* name;
   const char* description;
@@ -133,8 +193,17 @@ struct Entry {
 const std::vector<Entry>& models() {
   static const std::vector<Entry> kModels = {
       {"elastic", "isotropic linear (hypo-)elastic: E, nu, density", read_elastic},
-      {"perzyna_von_mises", "Perzyna viscoplastic von Mises with linear hardening/softening", read_perzyna_von_mises},
-      {"perzyna_cam_clay", "Perzyna viscoplastic modified Cam-Clay with p_c hardening", read_perzyna_cam_clay},
+      {"perzyna_von_mises", "Perzyna viscoplastic von Mises with linear hardening/softening (history: eps_vp_eq)",
+       read_perzyna_von_mises},
+      {"perzyna_cam_clay",
+       "Perzyna viscoplastic modified Cam-Clay with p_c hardening (history: eps_vp_eq, eps_vp_vol, p_c)",
+       read_perzyna_cam_clay},
+      {"perzyna_drucker_prager",
+       "Perzyna viscoplastic Drucker-Prager (c, phi, dilatancy, rounded apex, c softening; history: eps_vp_eq)",
+       read_perzyna_drucker_prager},
+      {"perzyna_mohr_coulomb",
+       "Perzyna viscoplastic Mohr-Coulomb, Abbo-Sloan rounding (c, phi, dilatancy, c softening; history: eps_vp_eq)",
+       read_perzyna_mohr_coulomb},
   };
   return kModels;
 }

@@ -1,8 +1,12 @@
 #include "materials/perzyna_models.hpp"
 
+#include <cmath>
+
 #include "materials/hardening.hpp"
 #include "materials/perzyna.hpp"
 #include "materials/yield_cam_clay.hpp"
+#include "materials/yield_drucker_prager.hpp"
+#include "materials/yield_mohr_coulomb.hpp"
 #include "materials/yield_von_mises.hpp"
 
 namespace rktsph {
@@ -26,6 +30,34 @@ std::unique_ptr<Material> make_perzyna_cam_clay(const CamClayParameters& p) {
   h.ocr = p.ocr;
   return std::make_unique<PerzynaMaterial<CamClaySurface, CamClayHardening>>("perzyna_cam_clay", p.elastic, surf, h,
                                                                              p.overstress, p.fluidity);
+}
+
+std::unique_ptr<Material> make_perzyna_drucker_prager(const DruckerPragerParameters& p) {
+  const DruckerPragerCone cone = DruckerPragerCone::matched(p.match, p.friction_angle, p.dilatancy);
+  DruckerPragerSurface surf;
+  surf.eta = cone.eta;
+  surf.eta_flow = cone.eta_flow;
+  surf.round_F = p.apex_rounding * std::sin(p.friction_angle);
+  surf.round_Q = p.apex_rounding * std::sin(p.dilatancy);
+  // Y = xi c (eq. 1.10.1) with the linear law of c (eq. 1.10.8).
+  LinearHardening h;
+  h.Y0 = cone.xi * p.cohesion;
+  h.H = cone.xi * p.hardening_modulus;
+  h.Y_residual = cone.xi * p.residual_cohesion;
+  return std::make_unique<PerzynaMaterial<DruckerPragerSurface, LinearHardening>>("perzyna_drucker_prager", p.elastic,
+                                                                                  surf, h, p.overstress, p.fluidity);
+}
+
+std::unique_ptr<Material> make_perzyna_mohr_coulomb(const MohrCoulombParameters& p) {
+  const MohrCoulombSurface surf = MohrCoulombSurface::make(p.friction_angle, p.dilatancy, p.apex_rounding);
+  // Y = sqrt(3) cos(phi) c (eq. 1.11.1) with the linear law of c (eq. 1.10.8).
+  const double xi = std::sqrt(3.0) * std::cos(p.friction_angle);
+  LinearHardening h;
+  h.Y0 = xi * p.cohesion;
+  h.H = xi * p.hardening_modulus;
+  h.Y_residual = xi * p.residual_cohesion;
+  return std::make_unique<PerzynaMaterial<MohrCoulombSurface, LinearHardening>>("perzyna_mohr_coulomb", p.elastic, surf,
+                                                                                h, p.overstress, p.fluidity);
 }
 
 }  // namespace rktsph

@@ -5,6 +5,7 @@
 
 #include "materials/material.hpp"
 #include "materials/overstress.hpp"
+#include "materials/yield_drucker_prager.hpp"
 
 namespace rktsph {
 
@@ -33,5 +34,36 @@ struct CamClayParameters {
   Overstress overstress;
 };
 std::unique_ptr<Material> make_perzyna_cam_clay(const CamClayParameters& parameters);
+
+/// perzyna_drucker_prager (method-notes §1.10): cone fitted to (c, phi), potential of
+/// dilatancy psi, c = max(c0 + H_c eps_vp_eq, c_residual).
+struct DruckerPragerParameters {
+  ElasticConstants elastic;
+  double cohesion = 0.0;        // c0, Pa, > 0
+  double friction_angle = 0.0;  // phi, radians, in [0, pi/2)
+  double dilatancy = 0.0;       // psi, radians, in [0, phi]
+  DruckerPragerMatch match = DruckerPragerMatch::plane_strain;
+  double apex_rounding = 0.1;      // eps of delta = eps sin(angle) Y, in [0, 1)
+  double hardening_modulus = 0.0;  // H_c = dc/d eps_vp_eq, Pa (negative: softening)
+  double residual_cohesion = 0.0;  // floor of c, Pa, in (0, c0]
+  double fluidity = 0.0;           // gamma, 1/s
+  Overstress overstress;
+};
+std::unique_ptr<Material> make_perzyna_drucker_prager(const DruckerPragerParameters& parameters);
+
+/// perzyna_mohr_coulomb (method-notes §1.11): Abbo–Sloan rounded pyramid, potential of
+/// dilatancy psi, c = max(c0 + H_c eps_vp_eq, c_residual). The keys of Drucker–Prager but dp_match.
+struct MohrCoulombParameters {
+  ElasticConstants elastic;
+  double cohesion = 0.0;           // c0, Pa, > 0
+  double friction_angle = 0.0;     // phi, radians, in [0, pi/2)
+  double dilatancy = 0.0;          // psi, radians, in [0, phi]
+  double apex_rounding = 0.1;      // eps of delta = eps sin(angle) Y, in [0, 1)
+  double hardening_modulus = 0.0;  // H_c = dc/d eps_vp_eq, Pa (negative: softening)
+  double residual_cohesion = 0.0;  // floor of c, Pa, in (0, c0]
+  double fluidity = 0.0;           // gamma, 1/s
+  Overstress overstress;
+};
+std::unique_ptr<Material> make_perzyna_mohr_coulomb(const MohrCoulombParameters& parameters);
 
 }  // namespace rktsph

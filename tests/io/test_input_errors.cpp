@@ -256,7 +256,29 @@ TEST(InputErrors, UnknownMaterialModelListsKnownModels) {
   const std::string text = replace(kBase, "model = \"elastic\"", "model = \"mohr_coulomb\"");
   const auto o = run_case_text(dir, text);
   expect_error_at(o, line_of(text, "model = "), "material.model",
-                  {"mohr_coulomb", "elastic", "perzyna_von_mises", "perzyna_cam_clay"});
+                  {"mohr_coulomb", "elastic", "perzyna_von_mises", "perzyna_cam_clay", "perzyna_drucker_prager",
+                   "perzyna_mohr_coulomb"});
+}
+
+TEST(InputErrors, FrictionalMaterialOutOfRange) {
+  test::TempDir dir;
+  const std::string dp = replace(kBase, "model = \"elastic\"",
+                                 "model = \"perzyna_drucker_prager\"\ncohesion = 1.0e4\nfriction_angle = 30.0\n"
+                                 "dilatancy = 10.0\nfluidity = 1.0");
+  EXPECT_EQ(run_case_text(dir, dp).status, 0);
+  {
+    const std::string text = replace(dp, "friction_angle = 30.0", "friction_angle = 95.0");
+    expect_error_at(run_case_text(dir, text), line_of(text, "friction_angle = "), "material.friction_angle",
+                    {"[0, 90)", "95"});
+  }
+  {
+    const std::string text = replace(dp, "dilatancy = 10.0", "dilatancy = 40.0");
+    expect_error_at(run_case_text(dir, text), line_of(text, "dilatancy = "), "material.dilatancy", {"40"});
+  }
+  {
+    const std::string text = replace(dp, "cohesion = 1.0e4", "cohesion = -1.0");
+    expect_error_at(run_case_text(dir, text), line_of(text, "cohesion = "), "material.cohesion", {"> 0 Pa"});
+  }
 }
 
 TEST(InputErrors, InvalidTomlSyntax) {

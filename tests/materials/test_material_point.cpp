@@ -88,6 +88,46 @@ TEST(MaterialPointCase, BadMaterialInputNamesKeyAndFile) {
                      "material.residual_yield_stress");
 }
 
+TEST(MaterialPointCase, BadDruckerPragerInputNamesKeyAndFile) {
+  const std::string dp =
+      "[material]\nmodel = 'perzyna_drucker_prager'\nE = 1e7\nnu = 0.3\ndensity = 2000\nfluidity = 1\n";
+  const std::string good = "cohesion = 1e4\nfriction_angle = 30\n";
+  const std::string rest = "[path]\ntype = 'simple_shear'\nshear_strain_rate = 1\nduration = 1\n";
+  EXPECT_NO_THROW(load_material_point_case(write_case("mp_dp_good.toml", dp + good + rest), {}));
+  expect_input_error("mp_dp_c.toml", dp + "cohesion = -1e4\nfriction_angle = 30\n" + rest, "material.cohesion",
+                     "> 0 Pa");
+  expect_input_error("mp_dp_c0.toml", dp + "cohesion = 0\nfriction_angle = 30\n" + rest, "material.cohesion");
+  expect_input_error("mp_dp_nophi.toml", dp + "cohesion = 1e4\n" + rest, "material.friction_angle", "missing");
+  expect_input_error("mp_dp_phineg.toml", dp + "cohesion = 1e4\nfriction_angle = -5\n" + rest,
+                     "material.friction_angle", "[0, 90)");
+  expect_input_error("mp_dp_phi90.toml", dp + "cohesion = 1e4\nfriction_angle = 90\n" + rest, "material.friction_angle",
+                     "[0, 90)");
+  expect_input_error("mp_dp_psi.toml", dp + good + "dilatancy = 35\n" + rest, "material.dilatancy",
+                     "the friction angle");
+  expect_input_error("mp_dp_psineg.toml", dp + good + "dilatancy = -1\n" + rest, "material.dilatancy");
+  expect_input_error("mp_dp_match.toml", dp + good + "dp_match = 'middle'\n" + rest, "material.dp_match", "middle");
+  expect_input_error("mp_dp_round.toml", dp + good + "apex_rounding = 1.0\n" + rest, "material.apex_rounding");
+  expect_input_error("mp_dp_res.toml", dp + good + "residual_cohesion = 2e4\n" + rest, "material.residual_cohesion",
+                     "(0, 10000]");
+  expect_input_error("mp_dp_typo.toml", dp + good + "dilatency = 5\n" + rest, "material.dilatency", "unknown key");
+}
+
+TEST(MaterialPointCase, BadMohrCoulombInputNamesKeyAndFile) {
+  const std::string mc =
+      "[material]\nmodel = 'perzyna_mohr_coulomb'\nE = 1e7\nnu = 0.3\ndensity = 2000\nfluidity = 1\n";
+  const std::string good = "cohesion = 1e4\nfriction_angle = 30\n";
+  const std::string rest = "[path]\ntype = 'simple_shear'\nshear_strain_rate = 1\nduration = 1\n";
+  const auto c = load_material_point_case(write_case("mp_mc_good.toml", mc + good + rest), {});
+  EXPECT_EQ(c.material->model(), "perzyna_mohr_coulomb");
+  expect_input_error("mp_mc_c.toml", mc + "cohesion = -1\nfriction_angle = 30\n" + rest, "material.cohesion");
+  expect_input_error("mp_mc_phi.toml", mc + "cohesion = 1e4\nfriction_angle = 90\n" + rest, "material.friction_angle",
+                     "[0, 90)");
+  expect_input_error("mp_mc_psi.toml", mc + good + "dilatancy = 31\n" + rest, "material.dilatancy",
+                     "the friction angle");
+  // dp_match belongs to Drucker-Prager only.
+  expect_input_error("mp_mc_match.toml", mc + good + "dp_match = 'outer'\n" + rest, "material.dp_match", "unknown key");
+}
+
 TEST(MaterialPointCase, BadPathInputNamesKeyAndFile) {
   expect_input_error("mp_type.toml", kGoodMaterial + "[path]\ntype = 'triaxial'\nduration = 1\n", "path.type",
                      "triaxial");
@@ -141,8 +181,9 @@ TEST(MaterialPointCase, RunWritesCsvWithTheDocumentedHeader) {
 }
 
 TEST(MaterialPointCase, ExampleCasesLoad) {
-  for (const char* name : {"von_mises_shear.toml", "cam_clay_drained_nc.toml", "cam_clay_undrained_nc.toml",
-                           "cam_clay_case3_biaxial.toml"}) {
+  for (const char* name :
+       {"von_mises_shear.toml", "cam_clay_drained_nc.toml", "cam_clay_undrained_nc.toml", "cam_clay_case3_biaxial.toml",
+        "drucker_prager_plane_strain.toml", "mohr_coulomb_triaxial.toml"}) {
     const std::string f = std::string(RKTSPH_SOURCE_DIR) + "/cases/material_point/" + name;
     EXPECT_NO_THROW(load_material_point_case(f, {})) << name;
   }

@@ -4,12 +4,17 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <string>
 #include <vector>
 
 #include "material_test_util.hpp"
 #include "materials/material_point_path.hpp"
 #include "materials/source_integrator.hpp"
 #include "materials/tensor.hpp"
+#include "materials/yield_drucker_prager.hpp"
+#include "materials/yield_mohr_coulomb.hpp"
 
 namespace rktsph {
 namespace {
@@ -447,6 +452,250 @@ TEST(PerzynaSource, BatchHonoursStateStride) {
   EXPECT_EQ(k1[5], -1.0);
   EXPECT_DOUBLE_EQ(out[0][3], 0.4 * tau1);
   EXPECT_LT(out[1][3], tau1);
+}
+
+// Drucker–Prager, E = 100 MPa, nu = 0.3, c = 10 kPa, default rounding 0.1 (method-notes §1.10).
+std::string drucker_prager(const std::string& match, double phi, double psi, double fluidity,
+                           const std::string& extra = "") {
+  return "model = 'perzyna_drucker_prager'\nE = 1.0e8\nnu = 0.3\ndensity = 2000.0\ncohesion = 1.0e4\n"
+         "friction_angle = " +
+         std::to_string(phi) + "\ndilatancy = " + std::to_string(psi) + "\ndp_match = '" + match +
+         "'\nfluidity = " + std::to_string(fluidity) + "\n" + extra;
+}
+
+constexpr double kDegree = std::numbers::pi / 180.0;
+
+DruckerPragerMatch match_of(const std::string& name) {
+  if (name == "outer") return DruckerPragerMatch::outer;
+  if (name == "inner") return DruckerPragerMatch::inner;
+  return DruckerPragerMatch::plane_strain;
+}
+
+double peak_q(const PathResult& r) {
+  double q = 0.0;
+  for (const PathPoint& p : r.points) q = std::max(q, q_of(p.stress));
+  return q;
+}
+
+TEST(DruckerPragerPerzyna, WithoutFrictionIsTheVonMisesModel) {
+  // phi = 0 with the plane-strain match: von Mises with Y = sqrt(3) c (method-notes eq. (1.7.5)).
+  auto dp = material_from_toml(drucker_prager("plane_strain", 0.0, 0.0, 3.0));
+  auto vm = material_from_toml(
+      "model = 'perzyna_von_mises'\nE = 1.0e8\nnu = 0.3\ndensity = 2000.0\ncohesion = 1.0e4\nfluidity = 3.0\n");
+  ASSERT_EQ(dp->state_size(), 1);
+  EXPECT_EQ(dp->state_names()[0], "eps_vp_eq");
+  const double k[1] = {0.0};
+  for (const Sym6& s :
+       {Sym6{-120e3, -80e3, -95e3, 15e3, -7e3, 4e3}, Sym6{2e4, -1e4, 0, 0, 0, 9e3}, Sym6{-1e5, -1e5, -1e5, 0, 0, 0}}) {
+    Sym6 d1, d2;
+    double k1[1], k2[1];
+    dp->source_rate(s, k, d1, k1);
+    vm->source_rate(s, k, d2, k2);
+    for (std::size_t i = 0; i < 6; ++i) EXPECT_NEAR(d1[i], d2[i], 1e-12 * (1.0 + std::abs(d2[i]))) << i;
+    EXPECT_NEAR(k1[0], k2[0], 1e-12 * (1.0 + k2[0]));
+    EXPECT_NEAR(dp->relaxation_rate(s, k), vm->relaxation_rate(s, k), 1e-12 * vm->relaxation_rate(s, k));
+  }
+  // Pure shear yields at tau = c, as cohesion does for von Mises.
+  EXPECT_EQ(dp->relaxation_rate({0, 0, 0, 1e4 * (1 - 1e-9), 0, 0}, k), 0.0);
+  EXPECT_GT(dp->relaxation_rate({0, 0, 0, 1e4 * (1 + 1e-6), 0, 0}, k), 0.0);
+}
+
+// Drained triaxial compression from p0 (sigma_xx = sigma_zz = -p0 held): the rate-independent
+// peak is on the cone, q = eta p' + xi c with p' = p0 + q/3, so q = (eta p0 + xi c)/(1 - eta/3)
+// (method-notes eq. (1.10.9)); for the outer cone this is the Mohr–Coulomb
+// q = 2 (p0 sin(phi) + c cos(phi))/(1 - sin(phi)).
+TEST(DruckerPragerPerzyna, FastLimitDrainedTriaxialPeakMatchesTheCone) {
+  const double p0 = 1e5, c = 1e4, phi = 30.0;
+  double worst = 0.0;
+  for (const char* match : {"plane_strain", "outer", "inner"}) {
+    for (double psi : {0.0, 30.0}) {
+      auto m = material_from_toml(drucker_prager(match, phi, psi, 20.0));
+      LoadPath path = LoadPath::drained_triaxial(-0.01);
+      path.duration = 1.0;  // 1 % axial strain; the peak is reached at about 0.25 %
+      path.dt = 1e-3;
+      const PathResult r = integrate_path(*m, {-p0, -p0, -p0, 0, 0, 0}, path);
+      const DruckerPragerCone cone = DruckerPragerCone::matched(match_of(match), phi * kDegree, psi * kDegree);
+      const double expected = (cone.eta * p0 + cone.xi * c) / (1.0 - cone.eta / 3.0);
+      const double q_end = q_of(r.points.back().stress);
+      const double err = std::abs(peak_q(r) - expected) / expected;
+      worst = std::max(worst, err);
+      EXPECT_LT(err, 1e-3) << match << " psi " << psi << ": peak " << peak_q(r) << " expected " << expected;
+      EXPECT_NEAR(q_end, peak_q(r), 1e-4 * expected) << match << " psi " << psi;  // perfectly plastic
+      EXPECT_NEAR(r.points.back().stress[0], -p0, 1e-6);
+      if (std::string(match) == "outer") {
+        const double sf = std::sin(phi * kDegree), cf = std::cos(phi * kDegree);
+        EXPECT_NEAR(expected, 2.0 * (p0 * sf + c * cf) / (1.0 - sf), 1e-9 * expected);
+      }
+      // Dilatancy: tr(eps_vp) > 0 for psi > 0; zero for psi = 0 (volume change only elastic).
+      const Sym6& e = r.points.back().strain;
+      const double elastic_volume = -(invariants(r.points.back().stress).p - p0) / m->elastic().K;
+      const double plastic_volume = tensor::trace(e) - elastic_volume;
+      if (psi > 0.0) {
+        EXPECT_GT(plastic_volume, 1e-3) << match;
+      } else {
+        EXPECT_NEAR(plastic_volume, 0.0, 1e-9) << match;
+      }
+    }
+  }
+  std::printf("[ figures  ] Drucker-Prager drained triaxial peak, worst relative error to the cone: %.2e\n", worst);
+}
+
+// Without the apex rounding the only departure from the cone is the overstress, O(1/gamma):
+// the Perzyna peak approaches the rate-independent one as the fluidity grows.
+TEST(DruckerPragerPerzyna, FastLimitConvergesAsOneOverFluidity) {
+  const double p0 = 1e5, c = 1e4;
+  const DruckerPragerCone cone = DruckerPragerCone::matched(DruckerPragerMatch::outer, 30.0 * kDegree, 0.0);
+  const double expected = (cone.eta * p0 + cone.xi * c) / (1.0 - cone.eta / 3.0);
+  double err[2];
+  const double gammas[2] = {5.0, 50.0};
+  for (int i = 0; i < 2; ++i) {
+    auto m = material_from_toml(drucker_prager("outer", 30.0, 0.0, gammas[i], "apex_rounding = 0.0\n"));
+    LoadPath path = LoadPath::drained_triaxial(-0.01);
+    path.duration = 1.0;
+    path.dt = 1e-3;
+    const PathResult r = integrate_path(*m, {-p0, -p0, -p0, 0, 0, 0}, path);
+    err[i] = (q_of(r.points.back().stress) - expected) / expected;
+  }
+  std::printf("[ figures  ] Drucker-Prager peak excess over the cone: %.2e (gamma = 5), %.2e (gamma = 50)\n", err[0],
+              err[1]);
+  EXPECT_GT(err[1], 0.0);  // the overstress is positive
+  EXPECT_LT(err[1], 1e-4);
+  EXPECT_GT(err[0] / err[1], 8.0);
+  EXPECT_LT(err[0] / err[1], 12.0);
+}
+
+// Plane-strain compression (sigma_xx = -p0 held, eps_zz = 0): with the plane-strain match of
+// eq. (1.10.5) the steady peak is the Mohr–Coulomb one, sigma_1 = p0 (1 + sin)/(1 - sin) +
+// 2 c cos/(1 - sin) (compression positive), for any dilatancy (method-notes eq. (1.10.10)).
+TEST(DruckerPragerPerzyna, PlaneStrainPeakMatchesMohrCoulomb) {
+  const double p0 = 1e5, c = 1e4, phi = 30.0;
+  const double sf = std::sin(phi * kDegree), cf = std::cos(phi * kDegree);
+  const double expected = p0 * (1 + sf) / (1 - sf) + 2 * c * cf / (1 - sf);  // 334.6 kPa
+  double worst = 0.0;
+  for (double psi : {0.0, 15.0, 30.0}) {
+    auto m = material_from_toml(drucker_prager("plane_strain", phi, psi, 20.0));
+    LoadPath path = LoadPath::plane_strain_compression(-0.01);
+    path.duration = 3.0;
+    path.dt = 1e-3;
+    const PathResult r = integrate_path(*m, {-p0, -p0, -p0, 0, 0, 0}, path);
+    const Sym6& end = r.points.back().stress;
+    const double err = std::abs(-end[1] - expected) / expected;
+    worst = std::max(worst, err);
+    EXPECT_LT(err, 1e-3) << "psi " << psi << ": sigma_yy " << end[1];
+    // sigma_zz is the intermediate principal stress.
+    EXPECT_LT(end[1], end[2]);
+    EXPECT_LT(end[2], end[0]);
+  }
+  std::printf("[ figures  ] Drucker-Prager plane-strain peak, worst relative error to Mohr-Coulomb: %.2e\n", worst);
+}
+
+// Linear softening of c (eq. (1.10.8)): the drained triaxial strength drops to the residual cone.
+TEST(DruckerPragerPerzyna, CohesionSofteningEndsOnTheResidualCone) {
+  const double p0 = 1e5, c = 1e4, c_res = 2e3;
+  auto m = material_from_toml(
+      drucker_prager("outer", 30.0, 0.0, 5.0, "hardening_modulus = -2.0e5\nresidual_cohesion = 2.0e3\n"));
+  LoadPath path = LoadPath::drained_triaxial(-0.05);
+  path.duration = 2.0;  // 10 % axial strain; c reaches the floor at eps_vp_eq = 0.04
+  path.dt = 1e-3;
+  const PathResult r = integrate_path(*m, {-p0, -p0, -p0, 0, 0, 0}, path);
+  const DruckerPragerCone cone = DruckerPragerCone::matched(DruckerPragerMatch::outer, 30.0 * kDegree, 0.0);
+  const double peak = (cone.eta * p0 + cone.xi * c) / (1.0 - cone.eta / 3.0);
+  const double residual = (cone.eta * p0 + cone.xi * c_res) / (1.0 - cone.eta / 3.0);
+  EXPECT_NEAR(peak_q(r), peak, 1e-2 * peak);
+  EXPECT_NEAR(q_of(r.points.back().stress), residual, 2e-3 * residual);
+  EXPECT_GT(r.points.back().state[0], 0.04);
+}
+
+// Mohr–Coulomb (Abbo–Sloan), E = 100 MPa, nu = 0.3, c = 10 kPa, default rounding 0.1 (method-notes §1.11).
+std::string mohr_coulomb(double phi, double psi, double fluidity) {
+  return "model = 'perzyna_mohr_coulomb'\nE = 1.0e8\nnu = 0.3\ndensity = 2000.0\ncohesion = 1.0e4\n"
+         "friction_angle = " +
+         std::to_string(phi) + "\ndilatancy = " + std::to_string(psi) + "\nfluidity = " + std::to_string(fluidity) +
+         "\n";
+}
+
+// Drained triaxial compression (theta = +30 deg, p' = p0 + q/3) and extension (theta = -30 deg,
+// p' = p0 - q/3), lateral stress held: the rate-independent peaks of the rounded surface are
+// q = sqrt3 (c cos + p0 sin)/(K(+-1) -+ sin/sqrt3) (method-notes eq. (1.11.6)); the sharp pyramid
+// gives 2 (c cos + p0 sin)/(1 -+ sin).
+TEST(MohrCoulombPerzyna, FastLimitTriaxialPeaks) {
+  const double p0 = 1e5, c = 1e4, phi = 30.0;
+  const double sf = std::sin(phi * kDegree), cf = std::cos(phi * kDegree), r3 = std::sqrt(3.0);
+  const LodeFactor K = LodeFactor::of(sf);
+  double worst_rounded = 0.0, sharp_error[2] = {0.0, 0.0};
+  for (int side = 0; side < 2; ++side) {
+    const double sign = side == 0 ? 1.0 : -1.0;  // compression, extension
+    const double rounded = r3 * (c * cf + p0 * sf) / (K(sign).K - sign * sf / r3);
+    const double sharp = 2.0 * (c * cf + p0 * sf) / (1.0 - sign * sf);
+    for (double psi : {0.0, 30.0}) {
+      auto m = material_from_toml(mohr_coulomb(phi, psi, 20.0));
+      LoadPath path = LoadPath::drained_triaxial(-sign * 0.01);
+      path.duration = 1.0;
+      path.dt = 1e-3;
+      const PathResult r = integrate_path(*m, {-p0, -p0, -p0, 0, 0, 0}, path);
+      const double q = peak_q(r);
+      const double err = std::abs(q - rounded) / rounded;
+      worst_rounded = std::max(worst_rounded, err);
+      sharp_error[side] = std::max(sharp_error[side], std::abs(q - sharp) / sharp);
+      EXPECT_LT(err, 1e-3) << "side " << side << " psi " << psi << ": q " << q << " expected " << rounded;
+      EXPECT_NEAR(q_of(r.points.back().stress), q, 1e-4 * q);
+      // The path stays on its meridian: sigma_yy is the major (compression) or minor principal stress.
+      const Sym6& e = r.points.back().stress;
+      EXPECT_NEAR(e[0], -p0, 1e-6);
+      EXPECT_NEAR(e[2], -p0, 1e-6);
+      EXPECT_NEAR(e[3], 0.0, 1e-9);
+    }
+  }
+  std::printf(
+      "[ figures  ] Mohr-Coulomb triaxial peaks: worst error to the rounded closed form %.2e; to the sharp "
+      "pyramid %.2e (compression), %.2e (extension)\n",
+      worst_rounded, sharp_error[0], sharp_error[1]);
+  // theta_T = 29 deg rounds the corners: the compression peak is 1.5 % below the sharp one at phi = 30.
+  EXPECT_LT(sharp_error[0], 2e-2);
+  EXPECT_LT(sharp_error[1], 3e-3);
+}
+
+// Plane-strain compression (sigma_xx = -p0 held, eps_zz = 0): sigma_zz stays intermediate, on a
+// face of the pyramid (|theta| < theta_T), where the rounded surface is the sharp one, so the
+// peak is eq. (1.10.10) for any dilatancy.
+TEST(MohrCoulombPerzyna, PlaneStrainPeakIsTheMohrCoulombOne) {
+  const double p0 = 1e5, c = 1e4, phi = 30.0;
+  const double sf = std::sin(phi * kDegree), cf = std::cos(phi * kDegree);
+  const double expected = p0 * (1 + sf) / (1 - sf) + 2 * c * cf / (1 - sf);
+  double worst = 0.0;
+  for (double psi : {0.0, 30.0}) {
+    auto m = material_from_toml(mohr_coulomb(phi, psi, 20.0));
+    LoadPath path = LoadPath::plane_strain_compression(-0.01);
+    path.duration = 1.5;
+    path.dt = 1e-3;
+    const PathResult r = integrate_path(*m, {-p0, -p0, -p0, 0, 0, 0}, path);
+    const Sym6& end = r.points.back().stress;
+    const double err = std::abs(-end[1] - expected) / expected;
+    worst = std::max(worst, err);
+    EXPECT_LT(err, 1e-3) << "psi " << psi << ": sigma_yy " << end[1];
+    EXPECT_LT(end[1], end[2]);
+    EXPECT_LT(end[2], end[0]);
+  }
+  std::printf("[ figures  ] Mohr-Coulomb plane-strain peak, worst relative error: %.2e\n", worst);
+}
+
+// phi = 0 in simple shear (theta = 0 throughout): the same path as von Mises with cohesion c.
+TEST(MohrCoulombPerzyna, WithoutFrictionShearsLikeVonMises) {
+  auto mc = material_from_toml(mohr_coulomb(0.0, 0.0, 2.0));
+  auto vm = material_from_toml(
+      "model = 'perzyna_von_mises'\nE = 1.0e8\nnu = 0.3\ndensity = 2000.0\ncohesion = 1.0e4\nfluidity = 2.0\n");
+  LoadPath path = LoadPath::simple_shear(0.02);
+  path.duration = 0.5;
+  path.dt = 1e-3;
+  const Sym6 s0{-1e5, -1e5, -1e5, 0, 0, 0};
+  const PathResult a = integrate_path(*mc, s0, path);
+  const PathResult b = integrate_path(*vm, s0, path);
+  ASSERT_EQ(a.points.size(), b.points.size());
+  for (std::size_t i = 0; i < 6; ++i) {
+    EXPECT_NEAR(a.points.back().stress[i], b.points.back().stress[i], 1e-9 * 1e5) << i;
+  }
+  EXPECT_NEAR(a.points.back().state[0], b.points.back().state[0], 1e-12);
+  EXPECT_GT(a.points.back().state[0], 1e-3);  // it did flow
 }
 
 }  // namespace

@@ -2,14 +2,19 @@
 // central finite differences), overstress functions and hardening laws.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <numbers>
+#include <vector>
 
 #include "materials/hardening.hpp"
 #include "materials/overstress.hpp"
 #include "materials/tensor.hpp"
 #include "materials/yield_cam_clay.hpp"
+#include "materials/yield_drucker_prager.hpp"
+#include "materials/yield_mohr_coulomb.hpp"
 #include "materials/yield_von_mises.hpp"
 
 namespace rktsph {
@@ -162,6 +167,306 @@ TEST(PerzynaParts, CamClayHardeningLaw) {
   CamClayHardening o{1.0, 0.0, 4.0};
   o.initial_state(50e3, k);
   EXPECT_DOUBLE_EQ(k[2], 200e3);
+}
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+// A Drucker–Prager surface as the registry builds it (perzyna_models.cpp), rounding eps.
+DruckerPragerSurface drucker_prager(DruckerPragerMatch match, double phi_deg, double psi_deg, double eps) {
+  const DruckerPragerCone cone = DruckerPragerCone::matched(match, phi_deg * kDeg, psi_deg * kDeg);
+  return {cone.eta, cone.eta_flow, eps * std::sin(phi_deg * kDeg), eps * std::sin(psi_deg * kDeg)};
+}
+
+bool all_finite(const Sym6& a) {
+  return std::all_of(a.begin(), a.end(), [](double v) { return std::isfinite(v); });
+}
+
+TEST(PerzynaParts, DruckerPragerValueGradientAndFlowMatchFiniteDifferences) {
+  const double Y = 30e3;  // xi c, Pa; delta_F = 0.1 sin(30 deg) Y = 1.5 kPa
+  const double p_apex = -Y / drucker_prager(DruckerPragerMatch::plane_strain, 30, 10, 0.1).eta;
+  const std::vector<Sym6> states{
+      kGeneral,
+      {-50e3, -50e3, -50e3, 300.0, 0, 0},                           // near the axis, q = 520 Pa < delta_F
+      {-50e3, -50e3, -50e3, 0, 0, 0},                               // on the axis (q = 0)
+      {p_apex, p_apex, p_apex, 0, 0, 0},                            // at the sharp cone's apex
+      {-3 * p_apex, -3 * p_apex + 100.0, -3 * p_apex, 0, 50.0, 0},  // far beyond the apex, in tension
+  };
+  double worst_grad = 0.0, worst_flow = 0.0;
+  for (DruckerPragerMatch match :
+       {DruckerPragerMatch::plane_strain, DruckerPragerMatch::outer, DruckerPragerMatch::inner}) {
+    const DruckerPragerSurface dp = drucker_prager(match, 30, 10, 0.1);
+    for (std::size_t k = 0; k < states.size(); ++k) {
+      const Sym6& s = states[k];
+      const Sym6 g = dp.gradient(s, Y);
+      const Sym6 fd = fd_gradient([&](const Sym6& t) { return dp.value(t, Y); }, s, 0.5);
+      const Sym6 m = dp.flow(s, Y);
+      const Sym6 fdm = fd_gradient([&](const Sym6& t) { return dp.potential(t, Y); }, s, 0.5);
+      for (std::size_t i = 0; i < 6; ++i) {
+        EXPECT_NEAR(g[i], fd[i], 1e-6 * (1.0 + std::abs(fd[i]))) << "state " << k << " i " << i;
+        EXPECT_NEAR(m[i], fdm[i], 1e-6 * (1.0 + std::abs(fdm[i]))) << "state " << k << " i " << i;
+        worst_grad = std::max(worst_grad, std::abs(g[i] - fd[i]));
+        worst_flow = std::max(worst_flow, std::abs(m[i] - fdm[i]));
+      }
+    }
+  }
+  std::printf("[ figures  ] Drucker-Prager max |dF/dsigma - FD| = %.2e, max |m - dQ/dsigma FD| = %.2e\n", worst_grad,
+              worst_flow);
+  // The flow slope is the potential's, not the surface's (non-associated): tr m = eta_Q.
+  const DruckerPragerSurface dp = drucker_prager(DruckerPragerMatch::plane_strain, 30, 10, 0.1);
+  EXPECT_NEAR(tensor::trace(dp.flow(kGeneral, Y)), dp.eta_flow, 1e-14);
+  EXPECT_NEAR(tensor::trace(dp.gradient(kGeneral, Y)), dp.eta, 1e-14);
+  EXPECT_LT(dp.eta_flow, dp.eta);
+}
+
+// The cone against the Mohr–Coulomb strength of the matched meridian (no rounding): on the
+// compression meridian for the outer cone, the extension meridian for the inner one.
+TEST(PerzynaParts, DruckerPragerMatchesMohrCoulombOnItsMeridian) {
+  const double phi = 30 * kDeg, c = 20e3, sf = std::sin(phi), cf = std::cos(phi);
+  const double confining = 80e3;                                                 // sigma_3, compression positive
+  const double major = confining * (1 + sf) / (1 - sf) + 2 * c * cf / (1 - sf);  // sigma_1 on MC
+  struct Case {
+    DruckerPragerMatch match;
+    Sym6 stress;
+  };
+  const Case cases[] = {
+      {DruckerPragerMatch::outer, {-confining, -major, -confining, 0, 0, 0}},  // triaxial compression
+      {DruckerPragerMatch::inner, {-major, -confining, -major, 0, 0, 0}},      // triaxial extension
+  };
+  for (const Case& k : cases) {
+    const DruckerPragerCone cone = DruckerPragerCone::matched(k.match, phi, 0.0);
+    const DruckerPragerSurface dp{cone.eta, 0.0, 0.0, 0.0};
+    EXPECT_NEAR(dp.value(k.stress, cone.xi * c), cone.xi * c, 1e-9 * cone.xi * c);
+  }
+  // Plane-strain match, associated: the classical sqrt(J2) = k + 3 alpha p' with
+  // alpha = tan(phi)/sqrt(9 + 12 tan^2 phi), k = 3c/sqrt(9 + 12 tan^2 phi); eta = 3 sqrt3 alpha, xi c = sqrt3 k.
+  const DruckerPragerCone ps = DruckerPragerCone::matched(DruckerPragerMatch::plane_strain, phi, phi);
+  const double t = std::tan(phi);
+  EXPECT_NEAR(ps.eta, std::sqrt(3.0) * 3 * t / std::sqrt(9 + 12 * t * t), 1e-14);
+  EXPECT_NEAR(ps.xi, std::sqrt(3.0) * 3 / std::sqrt(9 + 12 * t * t), 1e-14);
+  EXPECT_NEAR(ps.eta_flow, ps.eta, 1e-14);
+  // Plane-strain match with psi = 0: alpha = sin(phi)/3, k = c cos(phi) (sqrt(J2) form).
+  const DruckerPragerCone ps0 = DruckerPragerCone::matched(DruckerPragerMatch::plane_strain, phi, 0.0);
+  EXPECT_NEAR(ps0.eta, std::sqrt(3.0) * sf, 1e-14);
+  EXPECT_NEAR(ps0.xi, std::sqrt(3.0) * cf, 1e-14);
+  EXPECT_EQ(ps0.eta_flow, 0.0);
+  // phi = 0: von Mises with Y = sqrt(3) c (plane strain) or 2 c (through the Tresca corners).
+  EXPECT_NEAR(DruckerPragerCone::matched(DruckerPragerMatch::plane_strain, 0, 0).xi, std::sqrt(3.0), 1e-15);
+  EXPECT_NEAR(DruckerPragerCone::matched(DruckerPragerMatch::outer, 0, 0).xi, 2.0, 1e-15);
+  EXPECT_NEAR(DruckerPragerCone::matched(DruckerPragerMatch::inner, 0, 0).xi, 2.0, 1e-15);
+}
+
+TEST(PerzynaParts, DruckerPragerApexAndTensionStatesAreFinite) {
+  const double Y = 30e3;
+  for (double eps : {0.1, 0.0}) {
+    for (double psi : {0.0, 20.0}) {
+      const DruckerPragerSurface dp = drucker_prager(DruckerPragerMatch::plane_strain, 35, psi, eps);
+      const double p_apex = -Y / dp.eta;
+      for (double p : {0.0, 0.5 * p_apex, p_apex, 10.0 * p_apex, -1e6}) {
+        const Sym6 s{-p, -p, -p, 0, 0, 0};
+        EXPECT_TRUE(std::isfinite(dp.value(s, Y))) << eps << " " << psi << " " << p;
+        EXPECT_TRUE(all_finite(dp.gradient(s, Y))) << eps << " " << psi << " " << p;
+        EXPECT_TRUE(all_finite(dp.flow(s, Y))) << eps << " " << psi << " " << p;
+      }
+      // Unstressed: inside (F = delta_F < Y).
+      EXPECT_LT(dp.value({}, Y), Y);
+      // On the axis the gradient is volumetric, eta/3 1; beyond the apex F > Y.
+      const Sym6 beyond{-2 * p_apex, -2 * p_apex, -2 * p_apex, 0, 0, 0};
+      EXPECT_GT(dp.value(beyond, Y), Y);
+      const Sym6 g = dp.gradient(beyond, Y);
+      EXPECT_NEAR(g[0], dp.eta / 3, 1e-15);
+      EXPECT_EQ(g[3], 0.0);
+      // With psi > 0 the flow there dilates (relieves the tension); with psi = 0 it is zero.
+      const Sym6 m = dp.flow(beyond, Y);
+      if (psi > 0) {
+        EXPECT_GT(tensor::trace(m), 0.0);
+      } else {
+        EXPECT_EQ(tensor::trace(m), 0.0);
+      }
+    }
+  }
+  // The rounded apex: F(q = 0) = Y at p' = -(1 - eps sin(phi)) Y/eta (eq. 1.10.1).
+  const DruckerPragerSurface dp = drucker_prager(DruckerPragerMatch::outer, 30, 0, 0.1);
+  const double p_round = -(1 - 0.05) * Y / dp.eta;
+  EXPECT_NEAR(dp.value({-p_round, -p_round, -p_round, 0, 0, 0}, Y), Y, 1e-9 * Y);
+}
+
+TEST(PerzynaParts, DruckerPragerWithoutFrictionIsVonMises) {
+  const VonMisesSurface vm;
+  const DruckerPragerSurface dp = drucker_prager(DruckerPragerMatch::plane_strain, 0, 0, 0.1);
+  EXPECT_EQ(dp.eta, 0.0);
+  EXPECT_EQ(dp.round_F, 0.0);
+  for (const Sym6& s : {kGeneral, Sym6{-1e5, -1e5, -1e5, 0, 0, 0}, Sym6{3e4, 0, -2e4, 0, 1e4, 0}}) {
+    EXPECT_NEAR(dp.value(s, 1e5), vm.value(s, 1e5), 1e-15 * vm.value(s, 1e5));
+    const Sym6 g = dp.gradient(s, 1e5), gv = vm.gradient(s, 1e5);
+    const Sym6 m = dp.flow(s, 1e5), mv = vm.flow(s, 1e5);
+    for (std::size_t i = 0; i < 6; ++i) {
+      EXPECT_NEAR(g[i], gv[i], 1e-15);
+      EXPECT_NEAR(m[i], mv[i], 1e-15);
+    }
+  }
+}
+
+// A stress of mean pressure p (compression positive), von Mises stress q and Lode angle theta
+// (eq. (1.1.3); +30 deg is triaxial compression), its principal axes turned by a (about z)
+// and b (about x) so that every component is non-zero.
+Sym6 lode_state(double p, double q, double theta_deg, double a = 0.4, double b = 0.7) {
+  const double t = theta_deg * kDeg, third = 2.0 * std::numbers::pi / 3.0;
+  const double d[3] = {-p + 2.0 * q / 3.0 * std::sin(t + third), -p + 2.0 * q / 3.0 * std::sin(t),
+                       -p + 2.0 * q / 3.0 * std::sin(t - third)};
+  const double ca = std::cos(a), sa = std::sin(a), cb = std::cos(b), sb = std::sin(b);
+  // R = Rx(b) Rz(a); sigma = R diag(d) R^T.
+  const double R[3][3] = {{ca, -sa, 0.0}, {cb * sa, cb * ca, -sb}, {sb * sa, sb * ca, cb}};
+  auto c = [&](int i, int j) {
+    double v = 0.0;
+    for (int k = 0; k < 3; ++k) v += R[i][k] * d[k] * R[j][k];
+    return v;
+  };
+  return {c(0, 0), c(1, 1), c(2, 2), c(0, 1), c(1, 2), c(0, 2)};
+}
+
+// Sharp Mohr–Coulomb in the form of eq. (1.11.1): sqrt3 [(s1 - s3)/2 - (s1 + s3)/2 sin(phi)]
+// with s1 >= s2 >= s3 the principal stresses, compression positive (from the same p, q, theta).
+double sharp_mohr_coulomb(double p, double q, double theta_deg, double phi_deg) {
+  const double t = theta_deg * kDeg, third = 2.0 * std::numbers::pi / 3.0;
+  double c[3] = {p - 2.0 * q / 3.0 * std::sin(t + third), p - 2.0 * q / 3.0 * std::sin(t),
+                 p - 2.0 * q / 3.0 * std::sin(t - third)};
+  std::sort(c, c + 3);
+  return std::sqrt(3.0) * (0.5 * (c[2] - c[0]) - 0.5 * (c[2] + c[0]) * std::sin(phi_deg * kDeg));
+}
+
+TEST(PerzynaParts, MohrCoulombLodeStateHelperHasTheRequestedInvariants) {
+  const Sym6 s = lode_state(80e3, 50e3, 20.0);
+  const Sym6 d = tensor::deviator(s);
+  const double J2 = 0.5 * tensor::ddot(d, d);
+  EXPECT_NEAR(invariants(s).p, 80e3, 1e-8);
+  EXPECT_NEAR(invariants(s).q, 50e3, 1e-8);
+  EXPECT_NEAR(MohrCoulombSurface::lode_x(d, J2, 1.0), std::sin(60.0 * kDeg), 1e-12);
+}
+
+TEST(PerzynaParts, MohrCoulombValueGradientAndFlowMatchFiniteDifferences) {
+  const double Y = 30e3;  // sqrt3 c cos(phi)
+  const MohrCoulombSurface mc = MohrCoulombSurface::make(30 * kDeg, 10 * kDeg, 0.1);
+  const double p_apex = -Y / (std::sqrt(3.0) * 0.5);
+  std::vector<Sym6> states{kGeneral,
+                           lode_state(80e3, 500.0, 13.0),
+                           {-50e3, -50e3, -50e3, 0, 0, 0},
+                           {p_apex, p_apex, p_apex, 0, 0, 0},
+                           lode_state(-3 * p_apex, 200.0, -17.0)};
+  // The Lode extremes, both sides of the transition theta_T = 29 deg, and inside.
+  for (double theta : {30.0, -30.0, 29.6, -29.6, 28.4, -28.4, 10.0, 0.0, -20.0}) {
+    states.push_back(lode_state(80e3, 50e3, theta));
+  }
+  double worst_grad = 0.0, worst_flow = 0.0;
+  for (std::size_t k = 0; k < states.size(); ++k) {
+    const Sym6& s = states[k];
+    // The step resolves the Lode variation at small q; on the axis the Lode factor of the
+    // perturbed state depends on the direction of the step, so the difference is only O(h).
+    const double h = std::clamp(1e-4 * invariants(s).q, 1e-3, 0.5);
+    const Sym6 g = mc.gradient(s, Y);
+    const Sym6 fd = fd_gradient([&](const Sym6& t) { return mc.value(t, Y); }, s, h);
+    const Sym6 m = mc.flow(s, Y);
+    const Sym6 fdm = fd_gradient([&](const Sym6& t) { return mc.potential(t, Y); }, s, h);
+    for (std::size_t i = 0; i < 6; ++i) {
+      EXPECT_NEAR(g[i], fd[i], 1e-6 * (1.0 + std::abs(fd[i]))) << "state " << k << " i " << i;
+      EXPECT_NEAR(m[i], fdm[i], 1e-6 * (1.0 + std::abs(fdm[i]))) << "state " << k << " i " << i;
+      worst_grad = std::max(worst_grad, std::abs(g[i] - fd[i]));
+      worst_flow = std::max(worst_flow, std::abs(m[i] - fdm[i]));
+    }
+  }
+  std::printf("[ figures  ] Mohr-Coulomb max |dF/dsigma - FD| = %.2e, max |m - dQ/dsigma FD| = %.2e\n", worst_grad,
+              worst_flow);
+  EXPECT_NEAR(tensor::trace(mc.flow(kGeneral, Y)), std::sqrt(3.0) * std::sin(10 * kDeg), 1e-14);
+}
+
+TEST(PerzynaParts, MohrCoulombLodeRoundingIsSmoothAndIsAbboSloans) {
+  const double tT = LodeFactor::kTransitionAngle;
+  for (double phi : {0.0, 20.0, 30.0, 40.0}) {
+    const double sf = std::sin(phi * kDeg);
+    const LodeFactor K = LodeFactor::of(sf);
+    // Abbo & Sloan (1995): A = cos(tT)/3 [3 + tan(tT) tan(3tT) + sign/sqrt3 (tan(3tT) - 3 tan(tT)) sin(phi)],
+    // B = [sign sin(tT) + sin(phi) cos(tT)/sqrt3] / (3 cos(3tT)).
+    for (double sign : {1.0, -1.0}) {
+      const double A =
+          std::cos(tT) / 3 *
+          (3 + std::tan(tT) * std::tan(3 * tT) + sign / std::sqrt(3.0) * (std::tan(3 * tT) - 3 * std::tan(tT)) * sf);
+      const double B = (sign * std::sin(tT) + sf * std::cos(tT) / std::sqrt(3.0)) / (3 * std::cos(3 * tT));
+      EXPECT_NEAR(sign > 0 ? K.A_plus : K.A_minus, A, 1e-12) << phi;
+      EXPECT_NEAR(sign > 0 ? K.B_plus : K.B_minus, B, 1e-12) << phi;
+      // K and dK/dtheta continuous at +-theta_T.
+      const double x_in = std::sin(3 * (sign * tT - sign * 1e-9)), x_out = std::sin(3 * (sign * tT + sign * 1e-9));
+      EXPECT_NEAR(K(x_in).K, K(x_out).K, 1e-8);
+      EXPECT_NEAR(K(x_in).dKdx, K(x_out).dKdx, 1e-6 * std::abs(K(x_out).dKdx));
+    }
+    // Inside the transition K is the exact Mohr–Coulomb factor.
+    const double th = 20 * kDeg;
+    EXPECT_NEAR(K(std::sin(3 * th)).K, std::cos(th) - sf * std::sin(th) / std::sqrt(3.0), 1e-14);
+    const double corner_c = std::cos(30 * kDeg) - sf * 0.5 / std::sqrt(3.0);
+    const double corner_e = std::cos(30 * kDeg) + sf * 0.5 / std::sqrt(3.0);
+    std::printf("[ figures  ] phi = %2.0f: K(+30)/K_MC - 1 = %.2e, K(-30)/K_MC - 1 = %.2e\n", phi,
+                K(1.0).K / corner_c - 1, K(-1.0).K / corner_e - 1);
+    // theta_T = 29 deg: the corners are rounded by 0.5 % (phi = 0) to 1.1 % (phi = 40 deg).
+    EXPECT_LT(std::abs(K(1.0).K / corner_c - 1), 1.2e-2);
+    EXPECT_LT(std::abs(K(-1.0).K / corner_e - 1), 1.2e-2);
+  }
+}
+
+TEST(PerzynaParts, MohrCoulombIsTheSharpPyramidOnItsFaces) {
+  const MohrCoulombSurface mc = MohrCoulombSurface::make(30 * kDeg, 0.0, 0.0);
+  for (double theta : {-28.0, -15.0, 0.0, 20.0, 28.9}) {
+    const double F = mc.value(lode_state(90e3, 70e3, theta), 1.0);
+    EXPECT_NEAR(F, sharp_mohr_coulomb(90e3, 70e3, theta, 30), 1e-9 * 70e3) << theta;
+  }
+  // At the corners the rounding is within 1 % (of the deviatoric part).
+  for (double theta : {30.0, -30.0}) {
+    const double F = mc.value(lode_state(90e3, 70e3, theta), 1.0);
+    const double sharp = sharp_mohr_coulomb(90e3, 70e3, theta, 30);
+    EXPECT_NEAR(F, sharp, 1e-2 * 70e3) << theta;
+    EXPECT_NE(F, sharp);
+  }
+}
+
+TEST(PerzynaParts, MohrCoulombWithoutFrictionIsRoundedTresca) {
+  const MohrCoulombSurface mc = MohrCoulombSurface::make(0.0, 0.0, 0.1);
+  const VonMisesSurface vm;
+  EXPECT_EQ(mc.round_F, 0.0);
+  // Pure shear (theta = 0): F = q, the gradient is von Mises'.
+  const Sym6 shear{0, 0, 0, 3e4, 0, 0};
+  EXPECT_NEAR(mc.value(shear, 1e5), vm.value(shear, 1e5), 1e-10);
+  for (std::size_t i = 0; i < 6; ++i) EXPECT_NEAR(mc.gradient(shear, 1e5)[i], vm.gradient(shear, 1e5)[i], 1e-14);
+  // Inside the transition: Tresca, sqrt3 (sigma_1 - sigma_3)/2, whatever the pressure.
+  for (double theta : {-25.0, 10.0, 28.0}) {
+    EXPECT_NEAR(mc.value(lode_state(-4e4, 6e4, theta), 1e5), sharp_mohr_coulomb(-4e4, 6e4, theta, 0), 1e-9 * 6e4);
+  }
+  // Hydrostatic (q = 0, no rounding at phi = 0) and the corners: finite, no NaN.
+  for (const Sym6& s :
+       {Sym6{-1e5, -1e5, -1e5, 0, 0, 0}, Sym6{}, lode_state(1e5, 5e4, 30.0), lode_state(1e5, 5e4, -30.0)}) {
+    EXPECT_TRUE(std::isfinite(mc.value(s, 1e5)));
+    EXPECT_TRUE(all_finite(mc.gradient(s, 1e5)));
+    EXPECT_TRUE(all_finite(mc.flow(s, 1e5)));
+  }
+  const Sym6 g = mc.gradient({-1e5, -1e5, -1e5, 0, 0, 0}, 1e5);
+  for (double v : g) EXPECT_EQ(v, 0.0);
+}
+
+TEST(PerzynaParts, MohrCoulombApexAndTensionStatesAreFinite) {
+  const double Y = 30e3;
+  for (double eps : {0.1, 0.0}) {
+    for (double psi : {0.0, 20.0}) {
+      const MohrCoulombSurface mc = MohrCoulombSurface::make(35 * kDeg, psi * kDeg, eps);
+      const double p_apex = -Y / (std::sqrt(3.0) * std::sin(35 * kDeg));
+      for (double p : {0.0, 0.5 * p_apex, p_apex, 10.0 * p_apex, -1e6}) {
+        for (const Sym6& s : {Sym6{-p, -p, -p, 0, 0, 0}, lode_state(p, 1e-3, 30.0), lode_state(p, 1e-3, -30.0)}) {
+          EXPECT_TRUE(std::isfinite(mc.value(s, Y))) << eps << " " << psi << " " << p;
+          EXPECT_TRUE(all_finite(mc.gradient(s, Y))) << eps << " " << psi << " " << p;
+          EXPECT_TRUE(all_finite(mc.flow(s, Y))) << eps << " " << psi << " " << p;
+        }
+      }
+      EXPECT_LT(mc.value({}, Y), Y);
+      const Sym6 beyond{-2 * p_apex, -2 * p_apex, -2 * p_apex, 0, 0, 0};
+      EXPECT_GT(mc.value(beyond, Y), Y);
+      EXPECT_NEAR(tensor::trace(mc.flow(beyond, Y)), std::sqrt(3.0) * std::sin(psi * kDeg), 1e-12);
+    }
+  }
 }
 
 }  // namespace

@@ -1,0 +1,122 @@
+#pragma once
+// Mohr–Coulomb with the Abbo & Sloan (1995) hyperbolic and Lode-angle rounding (method-notes
+// §1.11), in the q–p′ form of the Drucker–Prager part (p′ = −tr σ/3, compression positive):
+//   F = sqrt(q^2 K_phi(theta)^2 + delta_F^2) − sqrt(3) sin(phi) p′,   Y = sqrt(3) c cos(phi)   (1.11.1)
+//   Q = sqrt(q^2 K_psi(theta)^2 + delta_Q^2) − sqrt(3) sin(psi) p′                             (1.11.4)
+// with delta = eps sin(angle) Y as in §1.10. K(theta) is the exact Mohr–Coulomb
+// cos(theta) − sin(angle) sin(theta)/sqrt(3) for |theta| <= theta_T = 29 deg and A − B sin(3 theta)
+// beyond (eq. 1.11.2), so F is smooth at the corners theta = ±30 deg. The Lode derivative is
+// taken through x = sin(3 theta) (as for Cam-Clay, method-notes §1.8): no cos(3 theta) -> 0.
+// With phi = psi = 0 this is a rounded Tresca with Y = sqrt(3) c (equal to von Mises at theta = 0).
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include "core/types.hpp"
+#include "materials/tensor.hpp"
+
+namespace rktsph {
+
+/// The Lode factor K(x), x = sin(3 theta), of eqs. (1.11.2)–(1.11.3) for one angle (phi or psi).
+struct LodeFactor {
+  static constexpr double kTransitionAngle = 29.0 * std::numbers::pi / 180.0;  // theta_T
+
+  double sin_angle = 0.0;
+  double A_plus = 0.0, B_plus = 0.0;    // rounding for theta > theta_T
+  double A_minus = 0.0, B_minus = 0.0;  // rounding for theta < −theta_T
+
+  /// A and B from continuity of K and dK/dtheta at ±theta_T (eq. 1.11.3).
+  static LodeFactor of(double sin_angle) {
+    LodeFactor f;
+    f.sin_angle = sin_angle;
+    const double t = kTransitionAngle, r3 = std::sqrt(3.0);
+    for (double sign : {1.0, -1.0}) {
+      const double B = (sign * std::sin(t) + sin_angle * std::cos(t) / r3) / (3.0 * std::cos(3.0 * t));
+      const double A = std::cos(t) - sign * sin_angle * std::sin(t) / r3 + B * sign * std::sin(3.0 * t);
+      (sign > 0 ? f.A_plus : f.A_minus) = A;
+      (sign > 0 ? f.B_plus : f.B_minus) = B;
+    }
+    return f;
+  }
+
+  struct Value {
+    double K;     // K(x)
+    double dKdx;  // dK/dx
+  };
+
+  Value operator()(double x) const {
+    x = std::clamp(x, -1.0, 1.0);
+    const double theta = std::asin(x) / 3.0;
+    if (theta > kTransitionAngle) return {A_plus - B_plus * x, -B_plus};
+    if (theta < -kTransitionAngle) return {A_minus - B_minus * x, -B_minus};
+    const double r3 = std::sqrt(3.0);
+    const double K = std::cos(theta) - sin_angle * std::sin(theta) / r3;
+    const double dKdtheta = -std::sin(theta) - sin_angle * std::cos(theta) / r3;
+    return {K, dKdtheta / (3.0 * std::cos(3.0 * theta))};  // cos(3 theta) >= cos(87 deg) here
+  }
+};
+
+struct MohrCoulombSurface {
+  /// Below q = kLodeGuard * Y the Lode angle is undefined: theta = 0 (K = 1) and no Lode term.
+  static constexpr double kLodeGuard = 1e-9;
+
+  LodeFactor lode_F;     // K_phi
+  LodeFactor lode_Q;     // K_psi
+  double round_F = 0.0;  // eps sin(phi): delta_F = round_F * Y
+  double round_Q = 0.0;  // eps sin(psi)
+
+  static MohrCoulombSurface make(double phi, double psi, double eps) {
+    return {LodeFactor::of(std::sin(phi)), LodeFactor::of(std::sin(psi)), eps * std::sin(phi), eps * std::sin(psi)};
+  }
+
+  /// F of eq. (1.11.1), Pa.
+  double value(const Sym6& sigma, double Y) const { return function(sigma, Y, lode_F, round_F * Y); }
+  /// dF/dsigma, tensor components (eq. 1.11.5 with phi).
+  Sym6 gradient(const Sym6& sigma, double Y) const { return derivative(sigma, Y, lode_F, round_F * Y); }
+  /// m = dQ/dsigma (eq. 1.11.5 with psi).
+  Sym6 flow(const Sym6& sigma, double Y) const { return derivative(sigma, Y, lode_Q, round_Q * Y); }
+  /// Q of eq. (1.11.4), for the tests.
+  double potential(const Sym6& sigma, double Y) const { return function(sigma, Y, lode_Q, round_Q * Y); }
+
+  /// x = sin(3 theta) of eq. (1.1.3), 0 below the guard.
+  static double lode_x(const Sym6& s, double J2, double Y) {
+    if (3.0 * J2 <= kLodeGuard * kLodeGuard * Y * Y) return 0.0;
+    return std::clamp(-1.5 * std::sqrt(3.0) * tensor::determinant(s) / std::pow(J2, 1.5), -1.0, 1.0);
+  }
+
+ private:
+  static double function(const Sym6& sigma, double Y, const LodeFactor& lode, double delta) {
+    const Sym6 s = tensor::deviator(sigma);
+    const double J2 = 0.5 * tensor::ddot(s, s);
+    const double K = lode(lode_x(s, J2, Y)).K;
+    const double p = -tensor::trace(sigma) / 3.0;
+    return std::sqrt(3.0 * J2 * K * K + delta * delta) - std::sqrt(3.0) * lode.sin_angle * p;
+  }
+
+  // d/dsigma of sqrt(q^2 K^2 + delta^2) − sqrt3 sin(angle) p′:
+  //   (1.5 K^2 s + q^2 K dK/dx dx/dsigma)/R + (sin(angle)/sqrt3) 1,
+  //   q^2 dx/dsigma = −(9 sqrt3/2) J2^(−1/2) [t − 3 J3/(2 J2) s],  t = s.s − 2/3 J2 1.
+  static Sym6 derivative(const Sym6& sigma, double Y, const LodeFactor& lode, double delta) {
+    const Sym6 s = tensor::deviator(sigma);
+    const double J2 = 0.5 * tensor::ddot(s, s);
+    const bool lode_defined = 3.0 * J2 > kLodeGuard * kLodeGuard * Y * Y;
+    const LodeFactor::Value k = lode(lode_x(s, J2, Y));
+    const double R = std::sqrt(3.0 * J2 * k.K * k.K + delta * delta);
+    Sym6 g{};
+    // Without rounding (delta = 0) on the axis the deviatoric direction is round-off: none.
+    if (R > 0.0 && (lode_defined || delta > 0.0)) {
+      for (std::size_t i = 0; i < 6; ++i) g[i] = 1.5 * k.K * k.K * s[i] / R;
+      if (lode_defined) {
+        Sym6 t = tensor::square(s);
+        for (std::size_t i = 0; i < 3; ++i) t[i] -= 2.0 / 3.0 * J2;
+        const double b = 1.5 * tensor::determinant(s) / J2;
+        const double a = -4.5 * std::sqrt(3.0) / std::sqrt(J2) * k.K * k.dKdx / R;
+        for (std::size_t i = 0; i < 6; ++i) g[i] += a * (t[i] - b * s[i]);
+      }
+    }
+    for (std::size_t i = 0; i < 3; ++i) g[i] += lode.sin_angle / std::sqrt(3.0);
+    return g;
+  }
+};
+
+}  // namespace rktsph
