@@ -1,6 +1,7 @@
 #include "operators/corrected_operator.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -390,9 +391,9 @@ void rebuild_corrected_operator(const Relation<Dim>& candidates, const std::vect
   op.grad.resize(pairs);
   // Pass 2: the weights, row by row (method-notes §3.2), in fixed blocks of rows.
   const Index nblocks = (nt + kBuildBlock - 1) / kBuildBlock;
-  Index degenerate = 0;
-  static thread_local std::vector<Index> block_degenerate;
-  block_degenerate.assign(static_cast<std::size_t>(nblocks), 0);
+  // Degenerate rows are rare and counted from any thread (an integer sum: the same whatever the
+  // order). Not a thread_local: each worker would see its own, empty, copy.
+  std::atomic<Index> degenerate{0};
   exec::particle_for(
       policy, nblocks,
       [&](Index blk) {
@@ -412,7 +413,7 @@ void rebuild_corrected_operator(const Relation<Dim>& candidates, const std::vect
           const auto k0 = static_cast<std::size_t>(op.pattern_start[au]);
           if (!row_weights_fast<Dim>(row.data(), row.size(), sources, kernel, basis.data(), &op.interp[k0],
                                      &op.grad[k0])) {
-            ++block_degenerate[static_cast<std::size_t>(blk)];
+            degenerate.fetch_add(1, std::memory_order_relaxed);
           }
           const Index b0 = row.empty() ? 0 : row.front().b;
           op.base[au] = b0;
@@ -420,12 +421,11 @@ void rebuild_corrected_operator(const Relation<Dim>& candidates, const std::vect
         }
       },
       exec::Schedule::dynamic, nt);
-  for (const Index d : block_degenerate) degenerate += d;
   // One row per run: the rows share no pattern.
   op.run_start.resize(static_cast<std::size_t>(nt) + 1);
   for (Index a = 0; a <= nt; ++a) op.run_start[static_cast<std::size_t>(a)] = a;
   op.pair_count = pairs;
-  op.degenerate_rows = degenerate;
+  op.degenerate_rows = degenerate.load();
 }
 
 #define RKTSPH_INSTANTIATE(D)                                                                                        \

@@ -11,7 +11,9 @@
 
 #include <fmt/format.h>
 
+#include "../support/test_util.hpp"
 #include "core/kernel.hpp"
+#include "neighbours/relation.hpp"
 #include "operators/corrected_operator.hpp"
 #include "particles/lattice.hpp"
 
@@ -274,6 +276,30 @@ TEST(DifferenceGradient, ExactForLinearFieldWithExactFhat) {
     EXPECT_GT(worst_wrong_fhat, 0.1);
     RecordProperty(jittered ? "diff_grad_err_jittered" : "diff_grad_err_regular", fmt::format("{:.3g}", worst));
   }
+}
+
+// The in-place rebuild (V2) counts degenerate rows from whichever thread builds them. A row with
+// no source in its support is degenerate; here 4000 targets, every other one far from the
+// sources, so that the worker threads' blocks hold degenerate rows too (a per-thread counter
+// once crashed there).
+TEST(CorrectedOperator, TheRebuildCountsDegenerateRowsOnEveryThread) {
+  const test::ThreadCount threads(2);
+  const double dx = 0.1;
+  ParticleSet<2> sources("nodes");
+  for (int j = 0; j < 10; ++j) {
+    for (int i = 0; i < 400; ++i) sources.add(Vec<2>(i * dx, j * dx), dx * dx, 2000.0, 0);
+  }
+  std::vector<Vec<2>> targets;
+  for (int k = 0; k < 4000; ++k) {
+    const double x = (k % 400) * dx + 0.5 * dx;
+    targets.push_back(k % 2 == 0 ? Vec<2>(x, 0.45) : Vec<2>(x, 100.0 + 0.01 * k));
+  }
+  const CubicSplineKernel<2> kernel(1.2 * dx);
+  Relation<2> relation;
+  relation.build(targets, sources.position, operator_relation_options(kernel));
+  CorrectedOperator<2> op;
+  rebuild_corrected_operator<2>(relation, targets, sources, kernel, op, exec::Threads{16});
+  EXPECT_EQ(op.degenerate_rows, 2000);
 }
 
 }  // namespace
