@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <limits>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -398,8 +399,17 @@ int run_loop(const LoopInput& in) {
     }
     auto last_progress = t_loop;
     const long first = solver.step_count();
+    // Moving particles (V2) can lose their neighbours: say so once, when it first happens.
+    Index degenerate_seen = solver.degenerate_operator_rows();
     for (long n = first; n < total_steps; ++n) {
       solver.step();
+      if (solver.degenerate_operator_rows() > degenerate_seen) {
+        degenerate_seen = std::numeric_limits<Index>::max();
+        std::cerr << fmt::format(
+            "warning: at t = {:.6g} s, {} particles have too few neighbours for the corrected operator and use "
+            "plain SPH sums: the body is separating (gaps) or thinning below the kernel's support there\n",
+            solver.time(), solver.degenerate_operator_rows());
+      }
       const bool last = n + 1 == total_steps;
       if ((n + 1) % setup.probe_every == 0 || last) record_probes();
       if ((n + 1) % loop.energy_every == 0 || last) record_energy();

@@ -43,7 +43,7 @@ void RebuildOperators<Dim>::build_relations() {
 }
 
 template <int Dim>
-void RebuildOperators<Dim>::run(const StepContext&) {
+void RebuildOperators<Dim>::run(const StepContext& c) {
   const auto& which = m_.constraints.constrained();
   for (std::size_t k = 0; k < which.size(); ++k) {
     constrained_positions_[k] = m_.nodes.position[static_cast<std::size_t>(which[k])];
@@ -67,6 +67,21 @@ void RebuildOperators<Dim>::run(const StepContext&) {
       build_difference_gradient<Dim>(constrained_, constrained_positions_, m_.stress_points, m_.kernel);
   ++operator_builds_;
   operator_seconds_ += since(t0);
+  const Index degenerate = m_.degenerate_operator_rows();
+  if (degenerate > 0 && degenerate_first_time_ < 0.0) degenerate_first_time_ = c.t;
+  degenerate_max_ = std::max(degenerate_max_, degenerate);
+}
+
+template <int Dim>
+void RebuildOperators<Dim>::save(io::StateArchive& a, const std::string& prefix) const {
+  a.put_integer(prefix + "degenerate_max", degenerate_max_);
+  a.put(prefix + "degenerate_first_time", degenerate_first_time_);
+}
+
+template <int Dim>
+void RebuildOperators<Dim>::load(const io::StateArchive& a, const std::string& prefix) {
+  degenerate_max_ = static_cast<Index>(a.integer(prefix + "degenerate_max"));
+  degenerate_first_time_ = a.number(prefix + "degenerate_first_time");
 }
 
 template <int Dim>

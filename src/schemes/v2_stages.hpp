@@ -39,12 +39,17 @@ class RebuildOperators final : public Stage {
   const Relation<Dim>& node_neighbours() const { return node_neighbours_; }
   /// The stress points near each node (Verlet), for the surface nodes' difference gradient.
   const Relation<Dim>& stress_points_of_nodes() const { return to_nodes_; }
+  /// The degenerate-row record survives a resume; the lists are searched afresh after one.
+  void save(io::StateArchive& archive, const std::string& prefix) const override;
+  void load(const io::StateArchive& archive, const std::string& prefix) override;
   std::vector<std::pair<std::string, double>> report() const override {
     return {{"neighbour_searches", static_cast<double>(relation_builds_)},
             {"neighbour_search_seconds", relation_seconds_},
             {"operator_builds", static_cast<double>(operator_builds_)},
             {"operator_build_seconds", operator_seconds_},
-            {"verlet_skin", skin_}};
+            {"verlet_skin", skin_},
+            {"degenerate_rows_max", static_cast<double>(degenerate_max_)},
+            {"degenerate_rows_first_time", degenerate_first_time_}};
   }
 
  private:
@@ -57,6 +62,10 @@ class RebuildOperators final : public Stage {
   std::vector<Vec<Dim>> nodes_at_build_, stress_points_at_build_;
   long relation_builds_ = 0, operator_builds_ = 0;
   double relation_seconds_ = 0.0, operator_seconds_ = 0.0;
+  // Rows of the two operators with too few neighbours (plain SPH sums there): the most at any
+  // step, and the time they first appeared (-1: never). A body tearing apart shows here.
+  Index degenerate_max_ = 0;
+  double degenerate_first_time_ = -1.0;
 };
 
 /// The free surface of the nodes detected on their positions at t^n (method-notes §3.6), after

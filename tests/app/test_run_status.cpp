@@ -1,5 +1,6 @@
 // The status a run ends with: an energy that overflows while the velocities stay finite is an
-// unstable run (exit 3, summary "unstable"), never a completed one.
+// unstable run (exit 3, summary "unstable"), never a completed one; a V2 body that tears apart
+// is reported.
 #include <gtest/gtest.h>
 
 #include <fmt/format.h>
@@ -40,6 +41,54 @@ end = 0.01
   EXPECT_NE(r.out.find("non-finite"), std::string::npos) << r.out;
   const auto s = nlohmann::json::parse(test::read_text(dir.file("out/summary.json")));
   EXPECT_EQ(s.at("status"), "unstable");
+}
+
+// A V2 bar pulled apart by its grips at 3 m/s: once the neck thins below the kernel's support,
+// particles lose the neighbours of the corrected operator. The run says so once, with the
+// time, and summary.json keeps the most such rows and when they first appeared.
+TEST(RunStatus, AV2BodyTearingApartIsReportedOnce) {
+  test::TempDir dir;
+  const std::string file = dir.write("case.toml", R"(
+[geometry]
+dimension = 2
+spacing = 0.05
+[[geometry.block]]
+min = [0.0, 0.0]
+max = [1.0, 0.2]
+[material]
+model = "perzyna_von_mises"
+E = 1.0e6
+nu = 0.3
+density = 2000.0
+cohesion = 1.0e3
+fluidity = 100.0
+[[boundary]]
+name = "left grip"
+x = [0.0, 0.05]
+velocity = { x = -3.0, y = 0.0 }
+[[boundary]]
+name = "right grip"
+x = [0.95, 1.0]
+velocity = { x = 3.0, y = 0.0 }
+[solver]
+version = "v2"
+[output]
+interval = 0.5
+[time]
+end = 1.5
+cfl = 0.5
+)");
+  const auto r = test::run_command(
+      fmt::format("\"{}\" run \"{}\" --out \"{}\" -q -j 1 2>&1", RKTSPH_BINARY, file, dir.file("out")));
+  EXPECT_EQ(r.status, 0) << r.out;
+  const std::string needle = "particles have too few neighbours for the corrected operator";
+  const auto first = r.out.find(needle);
+  ASSERT_NE(first, std::string::npos) << r.out;
+  EXPECT_EQ(r.out.find(needle, first + 1), std::string::npos) << "warned more than once:\n" << r.out;
+  const auto s = nlohmann::json::parse(test::read_text(dir.file("out/summary.json")));
+  const auto& rebuild = s.at("stages").at("rebuild_operators");
+  EXPECT_GT(rebuild.at("degenerate_rows_max").get<double>(), 0.0);
+  EXPECT_GT(rebuild.at("degenerate_rows_first_time").get<double>(), 0.1);
 }
 
 }  // namespace
