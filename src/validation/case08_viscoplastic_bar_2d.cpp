@@ -14,6 +14,7 @@
 #include "case/case_reader.hpp"
 #include "core/error.hpp"
 #include "schemes/simulation.hpp"
+#include "schemes/v2_stages.hpp"
 #include "validation/band_common.hpp"
 #include "validation/validation.hpp"
 
@@ -64,6 +65,8 @@ struct BarRun {
   int interior_surface_nodes = 0;  // nodes inside the bar flagged as free surface at the end
   double min_spacing = 0.0;        // smallest node-to-node distance at the end / dx
   double neck_X_end = NAN, neck_width_end = NAN;
+  double degenerate_first_time = -1.0;  // s: the first operator rows with too few neighbours
+  double degenerate_max = 0.0;
   long steps = 0;
   double seconds = 0.0;
 };
@@ -252,6 +255,12 @@ BarRun run_bar(const std::string& case_file, double dx) {
   }
   out.min_spacing = std::sqrt(dmin2) / dx;
   neck(out.neck_width_end, out.neck_X_end);
+  if (const auto* rebuild = s.scheme().find<RebuildOperators<2>>()) {
+    for (const auto& [key, value] : rebuild->report()) {
+      if (key == "degenerate_rows_first_time") out.degenerate_first_time = value;
+      if (key == "degenerate_rows_max") out.degenerate_max = value;
+    }
+  }
   out.steps = s.step_count();
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
@@ -357,6 +366,9 @@ CaseReport validate_case08(const Options& opt, const std::string& dir) {
   }
   rep.metrics.push_back(
       metric(tag + ": smallest node spacing at the end / dx (clustering)", r.min_spacing, "", 0.0, ""));
+  rep.metrics.push_back(metric(tag + ": time the first particles lost the corrected operator's neighbours (-1: never)",
+                               r.degenerate_first_time, "", 0.0, "s"));
+  rep.metrics.push_back(metric(tag + ": most operator rows without enough neighbours", r.degenerate_max, "", 0.0, ""));
   rep.metrics.push_back(metric(tag + ": mass change (nodes and stress points)", r.mass_change, "<=", 1e-12, ""));
   rep.notes.push_back(fmt::format("{}: {} steps in {:.1f} s; the peak force at {:.2f} % elongation", tag, r.steps,
                                   r.seconds, 100.0 * peak_e));
