@@ -198,8 +198,17 @@ void BM_V2Step(benchmark::State& state) {
     state.SkipWithError("not a V2 run");
     return;
   }
+  const auto* surface = solver.scheme().find<DetectFreeSurface<2>>();
+  auto surface_seconds = [&] {
+    if (surface == nullptr) return 0.0;
+    for (const auto& [key, value] : surface->report()) {
+      if (key == "detection_seconds") return value;
+    }
+    return 0.0;
+  };
   const long searches0 = rebuild->relation_builds();
   const double search0 = rebuild->relation_seconds(), build0 = rebuild->operator_seconds();
+  const double surface0 = surface_seconds();
   const auto t0 = std::chrono::steady_clock::now();
   for (auto _ : state) {
     solver.step();
@@ -213,11 +222,17 @@ void BM_V2Step(benchmark::State& state) {
   state.counters["searches/step"] = static_cast<double>(rebuild->relation_builds() - searches0) / steps;
   state.counters["search_share"] = (rebuild->relation_seconds() - search0) / seconds;
   state.counters["operator_share"] = (rebuild->operator_seconds() - build0) / seconds;
+  state.counters["surface_share"] = (surface_seconds() - surface0) / seconds;
   state.counters["state_B/node"] = static_cast<double>(solver.state_bytes()) / nodes;
   state.counters["operator_B/node"] = static_cast<double>(solver.operator_bytes()) / nodes;
   state.counters["threads"] = static_cast<double>(state.range(1));
 }
-BENCHMARK(BM_V2Step)->Args({10000, 1})->Args({100000, 1})->Args({100000, 2})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_V2Step)
+    ->Args({10000, 1})
+    ->Args({100000, 1})
+    ->Args({100000, 2})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 // Neighbour search (cell list) and corrected-operator assembly of both directions, one thread:
 // the set-up the large-deformation version would repeat every step.
