@@ -32,14 +32,17 @@ void detect_free_surface(const ParticleSet<Dim>& set, const Relation<Dim>& relat
                          const CubicSplineKernel<Dim>& kernel, const FreeSurfaceOptions& options,
                          const std::vector<std::uint8_t>& previous, const std::vector<std::uint8_t>& excluded,
                          std::vector<std::uint8_t>& flags, std::vector<Vec<Dim>>& normals, const exec::Threads& policy,
-                         std::vector<std::uint8_t>* corners) {
+                         std::vector<std::uint8_t>* corners, FreeSurfaceScratch<Dim>* scratch) {
+  FreeSurfaceScratch<Dim> local;
+  FreeSurfaceScratch<Dim>& work = scratch != nullptr ? *scratch : local;
   const Index n = set.size();
   const double h = kernel.h();
   const double r2 = kernel.support_radius() * kernel.support_radius();
   const double near2 = 2.0 * h * h;  // (sqrt(2) h)^2
   flags.assign(static_cast<std::size_t>(n), 0);
   normals.assign(static_cast<std::size_t>(n), Vec<Dim>::Zero());
-  std::vector<double> lambda(static_cast<std::size_t>(n), 0.0);
+  std::vector<double>& lambda = work.lambda;
+  lambda.assign(static_cast<std::size_t>(n), 0.0);
   // Steps 1-3: B, the first normal, the pre-screen and the umbrella scan of the candidates.
   exec::particle_for(policy, n, [&](Index i) {
     const auto iu = static_cast<std::size_t>(i);
@@ -99,7 +102,8 @@ void detect_free_surface(const ParticleSet<Dim>& set, const Relation<Dim>& relat
   // Step 5: temporal coherence. A node not on the surface at the last step joins it only next to
   // one that was, or when its support is plainly one-sided (lambda <= surface_below).
   if (!previous.empty()) {
-    std::vector<std::uint8_t> keep(flags);
+    std::vector<std::uint8_t>& keep = work.keep;
+    keep = flags;
     exec::particle_for(policy, n, [&](Index i) {
       const auto iu = static_cast<std::size_t>(i);
       if (flags[iu] == 0 || previous[iu] != 0 || lambda[iu] <= options.surface_below) return;
@@ -121,7 +125,8 @@ void detect_free_surface(const ParticleSet<Dim>& set, const Relation<Dim>& relat
   if (corners != nullptr) corners->assign(static_cast<std::size_t>(n), 0);
   if constexpr (Dim == 2) {
     const double corner_cos = std::cos(kCornerTurn);
-    std::vector<Vec<Dim>> improved(normals);
+    std::vector<Vec<Dim>>& improved = work.improved;
+    improved = normals;
     exec::particle_for(policy, n, [&](Index i) {
       const auto iu = static_cast<std::size_t>(i);
       if (flags[iu] == 0) return;
@@ -194,12 +199,12 @@ void make_traction_free(const Vec<Dim>& n, double* s) {
   }
 }
 
-#define RKTSPH_INSTANTIATE(D)                                                                                   \
-  template void detect_free_surface<D>(const ParticleSet<D>&, const Relation<D>&, const CubicSplineKernel<D>&,  \
-                                       const FreeSurfaceOptions&, const std::vector<std::uint8_t>&,             \
-                                       const std::vector<std::uint8_t>&, std::vector<std::uint8_t>&,            \
-                                       std::vector<Vec<D>>&, const exec::Threads&, std::vector<std::uint8_t>*); \
-  template void make_traction_free<D>(const Vec<D>&, double*);                                                  \
+#define RKTSPH_INSTANTIATE(D)                                                                            \
+  template void detect_free_surface<D>(                                                                  \
+      const ParticleSet<D>&, const Relation<D>&, const CubicSplineKernel<D>&, const FreeSurfaceOptions&, \
+      const std::vector<std::uint8_t>&, const std::vector<std::uint8_t>&, std::vector<std::uint8_t>&,    \
+      std::vector<Vec<D>>&, const exec::Threads&, std::vector<std::uint8_t>*, FreeSurfaceScratch<D>*);   \
+  template void make_traction_free<D>(const Vec<D>&, double*);                                           \
   template void make_corner_traction_free<D>(double*);
 RKTSPH_INSTANTIATE(1)
 RKTSPH_INSTANTIATE(2)

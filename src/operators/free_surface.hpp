@@ -34,6 +34,14 @@ struct FreeSurfaceOptions {
   double interior_above = 0.75;  // lambda_min above which it is interior without the scan
 };
 
+/// Work space of detect_free_surface, kept by its caller between steps (no allocation once grown).
+template <int Dim>
+struct FreeSurfaceScratch {
+  std::vector<double> lambda;
+  std::vector<std::uint8_t> keep;
+  std::vector<Vec<Dim>> improved;
+};
+
 /// Flags (1 = free surface) and outward unit normals of every particle of `set`, from
 /// `relation` (the set's own neighbours within the support; a wider Verlet list is cut back).
 /// `previous` (may be empty) holds the flags of the last step for the temporal coherence;
@@ -44,7 +52,8 @@ void detect_free_surface(const ParticleSet<Dim>& set, const Relation<Dim>& relat
                          const CubicSplineKernel<Dim>& kernel, const FreeSurfaceOptions& options,
                          const std::vector<std::uint8_t>& previous, const std::vector<std::uint8_t>& excluded,
                          std::vector<std::uint8_t>& flags, std::vector<Vec<Dim>>& normals,
-                         const exec::Threads& policy = {}, std::vector<std::uint8_t>* corners = nullptr);
+                         const exec::Threads& policy = {}, std::vector<std::uint8_t>* corners = nullptr,
+                         FreeSurfaceScratch<Dim>* scratch = nullptr);
 
 /// Traction-free stress by rotation to the local frame (method-notes §3.7): sigma.n = 0 with the
 /// tangential stress kept, sigma <- sigma - (sigma n) (x) n - n (x) (sigma n) + (n.sigma n) n (x) n;

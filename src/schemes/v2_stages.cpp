@@ -111,7 +111,7 @@ void DetectFreeSurface<Dim>::run(const StepContext&) {
   for (std::size_t i = 0; i < previous_.size(); ++i) previous_[i] = flag(i, 0) != 0.0 ? 1 : 0;
   ++detections_;
   detect_free_surface<Dim>(m_.nodes, rebuild_.node_neighbours(), m_.kernel, FreeSurfaceOptions{}, previous_, excluded_,
-                           flags_, normals_, m_.policy, &corners_);
+                           flags_, normals_, m_.policy, &corners_, &scratch_);
   surface_.clear();
   for (std::size_t i = 0; i < nn; ++i) {
     flag(i, 0) = flags_[i];

@@ -83,7 +83,8 @@ class DetectFreeSurface final : public Stage {
   void run(const StepContext& context) override;
   std::size_t scratch_bytes() const override {
     return previous_.capacity() + flags_.capacity() + excluded_.capacity() + corners_.capacity() +
-           normals_.capacity() * sizeof(Vec<Dim>);
+           normals_.capacity() * sizeof(Vec<Dim>) + scratch_.lambda.capacity() * sizeof(double) +
+           scratch_.keep.capacity() + scratch_.improved.capacity() * sizeof(Vec<Dim>);
   }
   void save(io::StateArchive& archive, const std::string& prefix) const override;
   void load(const io::StateArchive& archive, const std::string& prefix) override;
@@ -99,6 +100,7 @@ class DetectFreeSurface final : public Stage {
   Field<double, 1> flag_field_;
   Field<double, Dim> normal_field_;
   std::vector<std::uint8_t> previous_, flags_, excluded_, corners_;
+  FreeSurfaceScratch<Dim> scratch_;
   std::vector<Vec<Dim>> normals_;
   std::vector<Index> surface_;  // the flagged nodes
   Index surface_nodes_ = 0;
