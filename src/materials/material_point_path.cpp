@@ -126,6 +126,7 @@ PathResult integrate_path(const Material& material, const Sym6& sigma0, const Lo
   std::vector<double> k(unk);
   material.initial_state(sig, k.data());
 
+  constexpr long kMaxPathSubsteps = 10'000'000;
   PathResult res;
   auto record = [&](double t) { res.points.push_back({t, eps, sig, k}); };
   record(0.0);
@@ -170,6 +171,14 @@ PathResult integrate_path(const Material& material, const Sym6& sigma0, const Lo
     }
     res.substeps += nsub;
     t = step + 1 == nsteps ? path.duration : t + dt;
+    // A bound on the whole path's work (the example paths need at most 1.1e6 sub-steps), so that
+    // an extreme input fails in seconds instead of running for hours.
+    if (res.substeps > kMaxPathSubsteps) {
+      throw SolverError(fmt::format(
+          "material point: the path needs more than {:.0e} RK4 sub-steps in all (relaxation rate {:.3g} 1/s with "
+          "dt = {:.3g} s, by t = {:.6g} s of {:.6g} s); reduce the fluidity or path.dt",
+          static_cast<double>(kMaxPathSubsteps), lam, dt, t, path.duration));
+    }
     if (!finite(sig) || !finite(eps)) {
       throw SolverError(fmt::format("material point: non-finite stress at t = {:.6g} s", t));
     }
