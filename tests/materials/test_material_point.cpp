@@ -222,9 +222,9 @@ TEST(MaterialPointCase, RunWritesCsvWithTheDocumentedHeader) {
 }
 
 TEST(MaterialPointCase, ExampleCasesLoad) {
-  for (const char* name :
-       {"von_mises_shear.toml", "cam_clay_drained_nc.toml", "cam_clay_undrained_nc.toml", "cam_clay_case3_biaxial.toml",
-        "drucker_prager_plane_strain.toml", "mohr_coulomb_triaxial.toml"}) {
+  for (const char* name : {"von_mises_shear.toml", "cam_clay_drained_nc.toml", "cam_clay_undrained_nc.toml",
+                           "cam_clay_case3_biaxial.toml", "drucker_prager_plane_strain.toml",
+                           "mohr_coulomb_triaxial.toml", "cam_clay_undrained_pressure_dependent.toml"}) {
     const std::string f = std::string(RKTSPH_SOURCE_DIR) + "/cases/material_point/" + name;
     EXPECT_NO_THROW(load_material_point_case(f, {})) << name;
   }
