@@ -231,7 +231,8 @@ const std::vector<Entry>& models() {
       {"perzyna_von_mises", "Perzyna viscoplastic von Mises with linear hardening/softening (history: eps_vp_eq)",
        read_perzyna_von_mises},
       {"perzyna_cam_clay",
-       "Perzyna viscoplastic modified Cam-Clay with p_c hardening (history: eps_vp_eq, eps_vp_vol, p_c)",
+       "Perzyna viscoplastic modified Cam-Clay with p_c hardening, constant or pressure-dependent elasticity "
+       "(history: eps_vp_eq, eps_vp_vol, p_c)",
        read_perzyna_cam_clay},
       {"perzyna_drucker_prager",
        "Perzyna viscoplastic Drucker-Prager (c, phi, dilatancy, rounded apex, c softening; history: eps_vp_eq)",
