@@ -79,9 +79,44 @@ std::unique_ptr<Material> read_perzyna_von_mises(const io::Section& s) {
   return make_perzyna_von_mises(p);
 }
 
+// The pressure-dependent elasticity keys of perzyna_cam_clay (method-notes eqs. (1.8.8)–(1.8.9)):
+// shear, nu or G, density, elastic_p_min, elastic_p_max.
+void read_pressure_dependent_elasticity(const io::Section& s, CamClayParameters& p) {
+  p.elasticity = CamClayElasticity::pressure_dependent;
+  const std::string shear = s.string("shear", "poisson");
+  if (shear == "poisson") {
+    p.shear = CamClayShear::poisson;
+    p.elastic.nu = s.number("nu");
+    s.require(p.elastic.nu > -1.0 && p.elastic.nu < 0.5, "nu",
+              fmt::format("Poisson's ratio must lie in (-1, 0.5), got {}", p.elastic.nu));
+  } else if (shear == "constant_G") {
+    p.shear = CamClayShear::constant_G;
+    p.shear_modulus = s.number("G");
+    s.require(p.shear_modulus > 0.0, "G", fmt::format("the shear modulus must be > 0 Pa, got {}", p.shear_modulus));
+  } else {
+    s.fail("shear", fmt::format("unknown shear law '{}' (known: poisson, constant_G)", shear));
+  }
+  p.elastic.density = s.number("density");
+  s.require(p.elastic.density > 0.0, "density", fmt::format("density must be > 0 kg/m^3, got {}", p.elastic.density));
+  p.elastic_p_min = s.number("elastic_p_min");
+  s.require(p.elastic_p_min > 0.0, "elastic_p_min",
+            fmt::format("the floor of p' in K = (1+e0) p'/kappa must be > 0 Pa, got {}", p.elastic_p_min));
+  p.elastic_p_max = s.number("elastic_p_max");
+  s.require(
+      p.elastic_p_max > p.elastic_p_min, "elastic_p_max",
+      fmt::format("the cap of p' in K must exceed elastic_p_min ({} Pa), got {}", p.elastic_p_min, p.elastic_p_max));
+}
+
 std::unique_ptr<Material> read_perzyna_cam_clay(const io::Section& s) {
   CamClayParameters p;
-  p.elastic = read_elastic_constants(s);
+  const std::string elasticity = s.string("elasticity", "constant");
+  if (elasticity == "constant") {
+    p.elastic = read_elastic_constants(s);
+  } else if (elasticity == "pressure_dependent") {
+    read_pressure_dependent_elasticity(s, p);
+  } else {
+    s.fail("elasticity", fmt::format("unknown elasticity '{}' (known: constant, pressure_dependent)", elasticity));
+  }
   const bool has_M = s.has("M");
   const bool has_phi = s.has("critical_state_friction_angle");
   if (has_M == has_phi) {
@@ -196,7 +231,8 @@ const std::vector<Entry>& models() {
       {"perzyna_von_mises", "Perzyna viscoplastic von Mises with linear hardening/softening (history: eps_vp_eq)",
        read_perzyna_von_mises},
       {"perzyna_cam_clay",
-       "Perzyna viscoplastic modified Cam-Clay with p_c hardening (history: eps_vp_eq, eps_vp_vol, p_c)",
+       "Perzyna viscoplastic modified Cam-Clay with p_c hardening, constant or pressure-dependent elasticity "
+       "(history: eps_vp_eq, eps_vp_vol, p_c)",
        read_perzyna_cam_clay},
       {"perzyna_drucker_prager",
        "Perzyna viscoplastic Drucker-Prager (c, phi, dilatancy, rounded apex, c softening; history: eps_vp_eq)",

@@ -22,6 +22,10 @@ ElasticConstants ElasticConstants::from_E_nu(double E, double nu, double density
   return c;
 }
 
+ElasticConstants ElasticConstants::from_K_G(double K, double G, double density) {
+  return from_E_nu(9.0 * K * G / (3.0 * K + G), (3.0 * K - 2.0 * G) / (2.0 * (3.0 * K + G)), density);
+}
+
 double ElasticConstants::p_wave_speed() const { return std::sqrt((K + 4.0 * G / 3.0) / density); }
 
 Sym6 ElasticConstants::apply(const Sym6& e) const {

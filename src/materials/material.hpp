@@ -11,6 +11,7 @@
 // Models are built from plain parameter structs (materials/perzyna_models.hpp); reading them
 // from a case file is case/'s business. History variables kappa are declared by name so that
 // output can write any of them.
+#include <algorithm>
 #include <memory>
 #include <span>
 #include <string>
@@ -32,6 +33,8 @@ struct ElasticConstants {
   double M = 0.0;        // constrained (P-wave) modulus lambda + 2G, Pa
 
   static ElasticConstants from_E_nu(double E, double nu, double density);
+  /// From the bulk and shear moduli K, G (Pa).
+  static ElasticConstants from_K_G(double K, double G, double density);
   /// Fastest elastic wave speed sqrt((K + 4G/3)/rho), m/s (method-notes §4.3).
   double p_wave_speed() const;
   /// sigma = D^e : eps for a full symmetric tensor (tensor shear components).
@@ -40,12 +43,66 @@ struct ElasticConstants {
   Sym6 apply_inverse(const Sym6& stress) const;
 };
 
+/// Pressure-dependent isotropic moduli of modified Cam-Clay (method-notes eqs. (1.8.8)–(1.8.9)):
+///   K = (1 + e0)/kappa * clamp(p', p_min, p_max),
+///   G = G_over_K K (constant Poisson's ratio)  or  G = G_constant (constant shear modulus),
+/// with p' = -tr(sigma)/3 positive in compression. Inactive (the moduli are constant) when
+/// v0_over_kappa is 0, the default.
+struct PressureDependentModuli {
+  double v0_over_kappa = 0.0;   // (1 + e0)/kappa, dimensionless
+  bool constant_shear = false;  // G = G_constant instead of a constant Poisson's ratio
+  double G_over_K = 0.0;        // 3(1 - 2 nu)/(2(1 + nu)), constant Poisson's ratio
+  double G_constant = 0.0;      // Pa, constant shear modulus
+  double p_min = 0.0;           // Pa: floor of p' in K (stiffness at and beyond zero stress)
+  double p_max = 0.0;           // Pa: cap of p' in K (the stiffness the time step is set for)
+
+  bool active() const { return v0_over_kappa > 0.0; }
+  /// K at the mean effective stress p' (Pa), eq. (1.8.8).
+  double bulk_modulus(double p) const { return v0_over_kappa * std::clamp(p, p_min, p_max); }
+  /// G for the bulk modulus K, eq. (1.8.9).
+  double shear_modulus(double K) const { return constant_shear ? G_constant : G_over_K * K; }
+};
+
 /// The elastic part of the stress rate (method-notes eq. (1.2.2)):
 ///   d sigma/dt = lambda tr(d) 1 + 2 G d,   d = sym grad v,
 /// with the full stress whatever the dimension (szz in plane strain; syy, szz in 1D).
+/// With pressure-dependent moduli (eq. (1.8.8)) lambda and G are the values at p_max (the
+/// stiffest, for the time step) and the rate of a particle uses the moduli at its own stress.
 struct ElasticRate {
   double lambda = 0.0;  // Pa
   double G = 0.0;       // Pa
+  PressureDependentModuli pressure{};
+
+  /// The constant moduli at a stress (per-dimension layout: the first three slots are the
+  /// normal stresses in every dimension); *this when the moduli are constant.
+  ElasticRate at(const double* sigma) const {
+    if (!pressure.active()) return *this;
+    const double K = pressure.bulk_modulus(-(sigma[0] + sigma[1] + sigma[2]) / 3.0);
+    const double shear = pressure.shear_modulus(K);
+    return {K - 2.0 / 3.0 * shear, shear, {}};
+  }
+
+  /// sigma = D^e : eps for a full symmetric tensor (tensor shear components), constant moduli.
+  Sym6 apply(const Sym6& e) const {
+    const double tr = e[0] + e[1] + e[2];
+    return {lambda * tr + 2.0 * G * e[0],
+            lambda * tr + 2.0 * G * e[1],
+            lambda * tr + 2.0 * G * e[2],
+            2.0 * G * e[3],
+            2.0 * G * e[4],
+            2.0 * G * e[5]};
+  }
+
+  /// The rate of a particle at the stress sigma (per-dimension layout): the constant moduli,
+  /// or those at its mean effective stress (eq. (1.8.8)).
+  template <int Dim>
+  void operator()(const double (&grad_v)[Dim][Dim], const double* sigma, double* dsig) const {
+    if (pressure.active()) {
+      at(sigma)(grad_v, dsig);
+    } else {
+      (*this)(grad_v, dsig);
+    }
+  }
 
   /// grad_v[d][k] = d v_k / d x_d; dsig in the per-dimension stress layout.
   template <int Dim>
@@ -98,7 +155,10 @@ struct SourceStats {
 
 class Material {
  public:
-  explicit Material(ElasticConstants elastic) : elastic_(elastic) {}
+  /// With pressure-dependent moduli, `elastic` holds the constants at p_max (wave speed, time
+  /// step, diagnostics) and the stress rates use those at each particle's stress.
+  explicit Material(ElasticConstants elastic, PressureDependentModuli pressure = {})
+      : elastic_(elastic), pressure_(pressure) {}
   virtual ~Material() = default;
   Material(const Material&) = delete;
   Material& operator=(const Material&) = delete;
@@ -108,8 +168,16 @@ class Material {
   const ElasticConstants& elastic() const { return elastic_; }
   double density() const { return elastic_.density; }
 
+  /// Pressure-dependent moduli (method-notes eq. (1.8.8)); inactive for constant elasticity.
+  const PressureDependentModuli& pressure_moduli() const { return pressure_; }
+  /// D^e(sigma) : eps, the elastic stiffness at the stress sigma applied to eps.
+  Sym6 apply_elastic(const Sym6& sigma, const Sym6& eps) const {
+    if (!pressure_.active()) return elastic_.apply(eps);
+    return ElasticRate{0.0, 0.0, pressure_}.at(sigma.data()).apply(eps);
+  }
+
   /// The constants of the elastic part of the stress rate (the flux).
-  virtual ElasticRate elastic_rate() const { return {elastic_.lambda, elastic_.G}; }
+  virtual ElasticRate elastic_rate() const { return {elastic_.lambda, elastic_.G, pressure_}; }
   /// The fastest wave the flux carries, m/s: it sets the time step (method-notes §4.3).
   virtual double wave_speed() const { return elastic_.p_wave_speed(); }
   /// The objective rate of the stress in large deformation.
@@ -140,6 +208,7 @@ class Material {
 
  private:
   ElasticConstants elastic_;
+  PressureDependentModuli pressure_;
 };
 
 /// Purely elastic model (method-notes §1.5).

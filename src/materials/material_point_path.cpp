@@ -47,30 +47,50 @@ using Mat6 = Eigen::Matrix<double, 6, 6>;
 class MixedRate {
  public:
   MixedRate(const Material& m, const LoadPath& path) : material_(m), path_(path) {
-    const ElasticConstants& el = m.elastic();
-    D_.setZero();
-    for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) D_(i, j) = el.lambda;
-    }
-    for (int i = 0; i < 6; ++i) D_(i, i) += 2.0 * el.G;  // tensor shear: sigma_xy = 2G eps_xy
     for (int i = 0; i < 6; ++i) {
       (path.control[static_cast<std::size_t>(i)] == Control::stress ? S_ : E_).push_back(i);
     }
-    // The stress-controlled block D_SS is constant: invert it once (at most 6 x 6).
-    const int ns = static_cast<int>(S_.size());
-    Dss_inv_.setZero();
-    if (ns > 0) {
-      Eigen::MatrixXd Dss(ns, ns);
-      for (int a = 0; a < ns; ++a) {
-        for (int b = 0; b < ns; ++b) Dss(a, b) = D_(S_[a], S_[b]);
-      }
-      Dss_inv_.topLeftCorner(ns, ns) = Dss.inverse();
-    }
+    // Constant moduli: D and the inverse of its stress-controlled block once. Pressure-dependent
+    // moduli (method-notes eq. (1.8.8)): both at each evaluation, from the current stress.
+    const ElasticConstants& el = m.elastic();
+    stiffness(el.lambda, el.G, D_, Dss_inv_);
   }
 
   /// sigma_dot, eps_dot, kappa_dot; with_source = false gives the purely elastic rates.
   void operator()(const Sym6& sigma, const double* k, Sym6& dsig, Sym6& deps, double* dk,
                   bool with_source = true) const {
+    if (!material_.pressure_moduli().active()) {
+      rate(D_, Dss_inv_, sigma, k, dsig, deps, dk, with_source);
+      return;
+    }
+    const ElasticRate at = material_.elastic_rate().at(sigma.data());
+    Mat6 D, Dss_inv;
+    stiffness(at.lambda, at.G, D, Dss_inv);
+    rate(D, Dss_inv, sigma, k, dsig, deps, dk, with_source);
+  }
+
+ private:
+  /// D^e (tensor shear: sigma_xy = 2G eps_xy) and the inverse of its stress-controlled block
+  /// (at most 6 x 6) in its top-left corner.
+  void stiffness(double lambda, double G, Mat6& D, Mat6& Dss_inv) const {
+    D.setZero();
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) D(i, j) = lambda;
+    }
+    for (int i = 0; i < 6; ++i) D(i, i) += 2.0 * G;
+    const int ns = static_cast<int>(S_.size());
+    Dss_inv.setZero();
+    if (ns > 0) {
+      Eigen::MatrixXd Dss(ns, ns);
+      for (int a = 0; a < ns; ++a) {
+        for (int b = 0; b < ns; ++b) Dss(a, b) = D(S_[a], S_[b]);
+      }
+      Dss_inv.topLeftCorner(ns, ns) = Dss.inverse();
+    }
+  }
+
+  void rate(const Mat6& D, const Mat6& Dss_inv, const Sym6& sigma, const double* k, Sym6& dsig, Sym6& deps, double* dk,
+            bool with_source) const {
     Sym6 src{};
     if (with_source) {
       material_.source_rate(sigma, k, src, dk);
@@ -84,22 +104,21 @@ class MixedRate {
     for (int a = 0; a < ns; ++a) {
       const auto ia = static_cast<std::size_t>(S_[a]);
       double r = path_.rate[ia] - src[ia];
-      for (int j : E_) r -= D_(S_[a], j) * deps[static_cast<std::size_t>(j)];
+      for (int j : E_) r -= D(S_[a], j) * deps[static_cast<std::size_t>(j)];
       rhs[a] = r;
     }
     for (int a = 0; a < ns; ++a) {
       double x = 0.0;
-      for (int b = 0; b < ns; ++b) x += Dss_inv_(a, b) * rhs[b];
+      for (int b = 0; b < ns; ++b) x += Dss_inv(a, b) * rhs[b];
       deps[static_cast<std::size_t>(S_[a])] = x;
     }
     for (int i = 0; i < 6; ++i) {
       double r = src[static_cast<std::size_t>(i)];
-      for (int j = 0; j < 6; ++j) r += D_(i, j) * deps[static_cast<std::size_t>(j)];
+      for (int j = 0; j < 6; ++j) r += D(i, j) * deps[static_cast<std::size_t>(j)];
       dsig[static_cast<std::size_t>(i)] = r;
     }
   }
 
- private:
   const Material& material_;
   const LoadPath& path_;
   Mat6 D_;

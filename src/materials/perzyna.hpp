@@ -25,8 +25,8 @@ template <class Surface, class Hardening>
 class PerzynaMaterial final : public Material {
  public:
   PerzynaMaterial(std::string model, ElasticConstants elastic, Surface surface, Hardening hardening,
-                  Overstress overstress, double fluidity)
-      : Material(elastic),
+                  Overstress overstress, double fluidity, PressureDependentModuli pressure = {})
+      : Material(elastic, pressure),
         model_(std::move(model)),
         names_(Hardening::names()),
         surface_(surface),
@@ -65,8 +65,8 @@ class PerzynaMaterial final : public Material {
     if (!(slope > 0.0)) return 0.0;
     const Sym6 m = surface_.flow(sigma, Y);
     const Sym6 n = surface_.gradient(sigma, Y);
-    const double stiff =
-        std::abs(tensor::ddot(n, elastic().apply(m))) + (1.0 + x) * std::abs(hardening_.size_rate_per_flow(m, state));
+    const double stiff = std::abs(tensor::ddot(n, apply_elastic(sigma, m))) +
+                         (1.0 + x) * std::abs(hardening_.size_rate_per_flow(m, state));
     return fluidity_ * slope * stiff / Y;
   }
 
@@ -92,9 +92,10 @@ class PerzynaMaterial final : public Material {
       for (int j = 0; j < Hardening::kSize; ++j) dstate[j] = 0.0;
       return;
     }
-    // eps_vp_dot in tensor components; D^e.apply gives sigma_xy = 2 G eps_xy (method-notes §1.6).
+    // eps_vp_dot in tensor components; D^e.apply gives sigma_xy = 2 G eps_xy (method-notes §1.6),
+    // with D^e at this stress when the moduli depend on the pressure (eq. (1.8.8)).
     const Sym6 evp = tensor::scaled(surface_.flow(sigma, Y), fluidity_ * phi);
-    const Sym6 d = elastic().apply(evp);
+    const Sym6 d = apply_elastic(sigma, evp);
     for (std::size_t i = 0; i < 6; ++i) dsigma[i] = -d[i];
     hardening_.rate(evp, state, dstate);
   }

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "core/error.hpp"
+
 #include "materials/hardening.hpp"
 #include "materials/perzyna.hpp"
 #include "materials/yield_cam_clay.hpp"
@@ -28,8 +30,28 @@ std::unique_ptr<Material> make_perzyna_cam_clay(const CamClayParameters& p) {
   h.v0_over_lambda_kappa = (1.0 + p.e0) / (p.lambda - p.kappa);
   h.p_c0 = p.p_c0;
   h.ocr = p.ocr;
-  return std::make_unique<PerzynaMaterial<CamClaySurface, CamClayHardening>>("perzyna_cam_clay", p.elastic, surf, h,
-                                                                             p.overstress, p.fluidity);
+  if (p.elasticity == CamClayElasticity::constant) {
+    return std::make_unique<PerzynaMaterial<CamClaySurface, CamClayHardening>>("perzyna_cam_clay", p.elastic, surf, h,
+                                                                               p.overstress, p.fluidity);
+  }
+  // Pressure-dependent moduli (method-notes eqs. (1.8.8)–(1.8.9)); the reference constants are
+  // those at p_max, the stiffest state, which sets the time step.
+  if (!(p.kappa > 0.0 && p.e0 > 0.0 && p.elastic_p_min > 0.0 && p.elastic_p_max > p.elastic_p_min)) {
+    throw InputError(
+        "perzyna_cam_clay: pressure-dependent elasticity needs kappa > 0, e0 > 0 and "
+        "0 < elastic_p_min < elastic_p_max");
+  }
+  PressureDependentModuli moduli;
+  moduli.v0_over_kappa = (1.0 + p.e0) / p.kappa;
+  moduli.constant_shear = p.shear == CamClayShear::constant_G;
+  moduli.G_over_K = 1.5 * (1.0 - 2.0 * p.elastic.nu) / (1.0 + p.elastic.nu);
+  moduli.G_constant = p.shear_modulus;
+  moduli.p_min = p.elastic_p_min;
+  moduli.p_max = p.elastic_p_max;
+  const double K_max = moduli.bulk_modulus(p.elastic_p_max);
+  const ElasticConstants reference = ElasticConstants::from_K_G(K_max, moduli.shear_modulus(K_max), p.elastic.density);
+  return std::make_unique<PerzynaMaterial<CamClaySurface, CamClayHardening>>("perzyna_cam_clay", reference, surf, h,
+                                                                             p.overstress, p.fluidity, moduli);
 }
 
 std::unique_ptr<Material> make_perzyna_drucker_prager(const DruckerPragerParameters& p) {

@@ -20,17 +20,28 @@ struct VonMisesParameters {
 };
 std::unique_ptr<Material> make_perzyna_von_mises(const VonMisesParameters& parameters);
 
+/// Elasticity of perzyna_cam_clay: constant E and nu (the default), or the pressure-dependent
+/// bulk modulus K = (1 + e0) p'/kappa (method-notes eqs. (1.8.8)–(1.8.9)).
+enum class CamClayElasticity { constant, pressure_dependent };
+/// The shear modulus with pressure-dependent K: constant Poisson's ratio or constant G.
+enum class CamClayShear { poisson, constant_G };
+
 /// perzyna_cam_clay (method-notes §1.8): modified Cam-Clay with p_c hardening.
 struct CamClayParameters {
-  ElasticConstants elastic;
-  double M = 1.0;                 // critical-state slope in triaxial compression
-  bool lode_dependent_M = false;  // M(theta) instead of constant M
-  double lambda = 0.0;            // virgin compression slope
-  double kappa = 0.0;             // swelling slope
-  double e0 = 0.0;                // initial void ratio
-  double p_c0 = 0.0;              // Pa; used when > 0
-  double ocr = 0.0;               // used when p_c0 = 0: p_c0 = ocr x the size of the initial stress
-  double fluidity = 0.0;          // gamma, 1/s
+  ElasticConstants elastic;  // constant elasticity; pressure-dependent uses density and nu only
+  CamClayElasticity elasticity = CamClayElasticity::constant;
+  CamClayShear shear = CamClayShear::poisson;  // pressure-dependent only
+  double shear_modulus = 0.0;                  // G, Pa (pressure-dependent, constant_G)
+  double elastic_p_min = 0.0;                  // Pa: floor of p' in K (pressure-dependent)
+  double elastic_p_max = 0.0;                  // Pa: cap of p' in K, sets the time step
+  double M = 1.0;                              // critical-state slope in triaxial compression
+  bool lode_dependent_M = false;               // M(theta) instead of constant M
+  double lambda = 0.0;                         // virgin compression slope
+  double kappa = 0.0;                          // swelling slope
+  double e0 = 0.0;                             // initial void ratio
+  double p_c0 = 0.0;                           // Pa; used when > 0
+  double ocr = 0.0;                            // used when p_c0 = 0: p_c0 = ocr x the size of the initial stress
+  double fluidity = 0.0;                       // gamma, 1/s
   Overstress overstress;
 };
 std::unique_ptr<Material> make_perzyna_cam_clay(const CamClayParameters& parameters);

@@ -3,10 +3,21 @@
 #include <cmath>
 #include <utility>
 
+#include <fmt/format.h>
+
+#include "core/error.hpp"
+
 namespace rktsph {
 
 UniaxialStressMaterial::UniaxialStressMaterial(std::shared_ptr<const Material> inner)
-    : Material(inner->elastic()), inner_(std::move(inner)) {}
+    : Material(inner->elastic()), inner_(std::move(inner)) {
+  if (inner_->pressure_moduli().active()) {
+    throw InputError(
+        fmt::format("{}: pressure-dependent elasticity is not available with the 1D uniaxial-stress "
+                    "bar condition (it uses the constant E); use elasticity = \"constant\"",
+                    inner_->model()));
+  }
+}
 
 double UniaxialStressMaterial::wave_speed() const { return std::sqrt(elastic().E / density()); }
 

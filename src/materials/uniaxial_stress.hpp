@@ -20,7 +20,7 @@ class UniaxialStressMaterial final : public Material {
   explicit UniaxialStressMaterial(std::shared_ptr<const Material> inner);
 
   std::string_view model() const override { return inner_->model(); }
-  ElasticRate elastic_rate() const override { return {0.0, 0.5 * elastic().E}; }
+  ElasticRate elastic_rate() const override { return {0.0, 0.5 * elastic().E, {}}; }
   double wave_speed() const override;
   std::span<const std::string> state_names() const override { return inner_->state_names(); }
   void initial_state(const Sym6& sigma, double* state) const override;

@@ -142,7 +142,8 @@ void StressPointHalfStep<Dim, PressureTerm, Motion>::run(const StepContext& c) {
           const int mat = sp.material[eu];
           double dv[Dim], dsig[NS];
           momentum_rate<Dim>(grad_s, 1.0 / sp.density[eu], dv);
-          m_.materials.elastic[static_cast<std::size_t>(mat)](grad_v, dsig);
+          // The moduli at the interpolated stress when they depend on it (method-notes eq. (1.8.8)).
+          m_.materials.elastic[static_cast<std::size_t>(mat)](grad_v, bar_s, dsig);
           if constexpr (PressureTerm::kActive) {
             // V3 (method-notes §5.3): -grad p^n / rho in the stress points' half step.
             if (pressure.skeleton.data() != nullptr) {
@@ -320,7 +321,8 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
           const int mat = nodes.material[iu];
           double dv[Dim], dsig[NS];
           momentum_rate<Dim>(grad_s, 1.0 / nodes.density[iu], dv);
-          m_.materials.elastic[static_cast<std::size_t>(mat)](grad_v, dsig);
+          // The moduli at the node's stress at t^n when they depend on it (method-notes eq. (1.8.8)).
+          m_.materials.elastic[static_cast<std::size_t>(mat)](grad_v, node_s[i], dsig);
           double* v = node_v[i];
           double* s = node_s[i];
           if constexpr (Velocity::kSimple) {

@@ -128,6 +128,47 @@ TEST(MaterialPointCase, BadMohrCoulombInputNamesKeyAndFile) {
   expect_input_error("mp_mc_match.toml", mc + good + "dp_match = 'outer'\n" + rest, "material.dp_match", "unknown key");
 }
 
+// Pressure-dependent Cam-Clay elasticity (method-notes eq. (1.8.8)): its keys and their errors.
+TEST(MaterialPointCase, BadPressureDependentElasticityNamesKeyLineAndFile) {
+  const std::string pd =
+      "[material]\nmodel = 'perzyna_cam_clay'\nelasticity = 'pressure_dependent'\nnu = 0.3\ndensity = 2000\n"
+      "M = 1.2\nlambda = 0.2\nkappa = 0.02\ne0 = 1.0\np_c0 = 1e5\nfluidity = 10\nelastic_p_min = 1e3\n"
+      "elastic_p_max = 1e7\n";
+  auto replace = [&](const std::string& key, const std::string& line) {
+    std::string m = pd;
+    const auto pos = m.find("\n" + key + " = ");
+    const auto end = m.find('\n', pos + 1);
+    return m.substr(0, pos + 1) + line + m.substr(end) + kGoodRest;
+  };
+  const auto c = load_material_point_case(write_case("mp_pd_good.toml", pd + kGoodRest), {});
+  EXPECT_TRUE(c.material->pressure_moduli().active());
+  EXPECT_NO_THROW(
+      load_material_point_case(write_case("mp_pd_G.toml", replace("nu", "shear = 'constant_G'\nG = 3e6") + ""), {}));
+  expect_input_error("mp_pd_kind.toml", replace("elasticity", "elasticity = 'hyper'"), "material.elasticity", "hyper");
+  expect_input_error("mp_pd_shear.toml", replace("nu", "shear = 'poison'\nnu = 0.3"), "material.shear", "poison");
+  expect_input_error("mp_pd_kappa0.toml", replace("kappa", "kappa = 0"), "material.kappa", "> 0");
+  expect_input_error("mp_pd_kappaneg.toml", replace("kappa", "kappa = -0.02"), "material.kappa", "> 0");
+  expect_input_error("mp_pd_e0.toml", replace("e0", "# e0 missing"), "material.e0", "missing");
+  expect_input_error("mp_pd_pmin.toml", replace("elastic_p_min", "elastic_p_min = 0"), "material.elastic_p_min",
+                     "> 0 Pa");
+  expect_input_error("mp_pd_nopmax.toml", replace("elastic_p_max", "# no cap"), "material.elastic_p_max", "missing");
+  expect_input_error("mp_pd_pmax.toml", replace("elastic_p_max", "elastic_p_max = 500"), "material.elastic_p_max",
+                     "exceed");
+  expect_input_error("mp_pd_nu.toml", replace("nu", "nu = 0.5"), "material.nu", "(-1, 0.5)");
+  expect_input_error("mp_pd_G0.toml", replace("nu", "shear = 'constant_G'\nG = 0"), "material.G", "> 0 Pa");
+  // E is the constant law's key; G belongs to constant_G, nu to poisson; shear to pressure_dependent.
+  expect_input_error("mp_pd_E.toml", replace("nu", "nu = 0.3\nE = 2e7"), "material.E", "unknown key");
+  expect_input_error("mp_pd_Gnu.toml", replace("nu", "nu = 0.3\nG = 3e6"), "material.G", "unknown key");
+  expect_input_error("mp_pd_shearc.toml", with("shear", "shear = 'poisson'"), "material.shear", "unknown key");
+  // The errors name the line of the key.
+  try {
+    load_material_point_case(write_case("mp_pd_line.toml", replace("elastic_p_min", "elastic_p_min = -1")), {});
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("line 12"), std::string::npos) << e.what();
+  }
+}
+
 TEST(MaterialPointCase, BadPathInputNamesKeyAndFile) {
   expect_input_error("mp_type.toml", kGoodMaterial + "[path]\ntype = 'triaxial'\nduration = 1\n", "path.type",
                      "triaxial");
@@ -181,9 +222,9 @@ TEST(MaterialPointCase, RunWritesCsvWithTheDocumentedHeader) {
 }
 
 TEST(MaterialPointCase, ExampleCasesLoad) {
-  for (const char* name :
-       {"von_mises_shear.toml", "cam_clay_drained_nc.toml", "cam_clay_undrained_nc.toml", "cam_clay_case3_biaxial.toml",
-        "drucker_prager_plane_strain.toml", "mohr_coulomb_triaxial.toml"}) {
+  for (const char* name : {"von_mises_shear.toml", "cam_clay_drained_nc.toml", "cam_clay_undrained_nc.toml",
+                           "cam_clay_case3_biaxial.toml", "drucker_prager_plane_strain.toml",
+                           "mohr_coulomb_triaxial.toml", "cam_clay_undrained_pressure_dependent.toml"}) {
     const std::string f = std::string(RKTSPH_SOURCE_DIR) + "/cases/material_point/" + name;
     EXPECT_NO_THROW(load_material_point_case(f, {})) << name;
   }

@@ -102,6 +102,41 @@ TEST(UniformInitialStress, IsotropicConfinementStaysUniform) {
   }
 }
 
+// Pressure-dependent Cam-Clay elasticity in the flux (method-notes eq. (1.8.8)): a uniform
+// dilation v = a x from the uniform initial stress gives the stress rate of the moduli at the
+// particles' own p' = 50 kPa, while the time step is set by those at elastic_p_max.
+TEST(UniformInitialStress, PressureDependentModuliInTheFlux) {
+  std::string text = kSample2D;
+  text.replace(text.find("E = 2.0e7"), 9,
+               "elasticity = \"pressure_dependent\"\nelastic_p_min = 1.0e3\nelastic_p_max = 1.0e6");
+  Simulation<2> solver(setup_from<2>(text, "pd"));
+  const double v0_over_kappa = 2.0 / 0.02, ratio = 3.0 * (1 - 0.6) / (2 * 1.3);
+  const double K_max = v0_over_kappa * 1.0e6;
+  EXPECT_NEAR(solver.max_wave_speed(), std::sqrt((K_max + 4.0 / 3.0 * ratio * K_max) / 2000.0),
+              1e-9 * solver.max_wave_speed());
+  const double a = 1e-4;
+  auto v = solver.mutable_node_velocity();
+  const auto& nodes = solver.nodes();
+  for (std::size_t i = 0; i < nodes.position.size(); ++i) {
+    for (int d = 0; d < 2; ++d) v(i, d) = a * nodes.position[i][d];
+  }
+  solver.step();
+  const double K = v0_over_kappa * 5.0e4, G = ratio * K;
+  const double rate_xx = (K - 2.0 / 3.0 * G) * 2.0 * a + 2.0 * G * a;  // plane strain, tr d = 2a
+  const double rate_zz = (K - 2.0 / 3.0 * G) * 2.0 * a;
+  int checked = 0;
+  for (std::size_t i = 0; i < nodes.position.size(); ++i) {
+    const auto& x = nodes.position[i];
+    if (x[0] < 0.25 || x[0] > 0.75 || x[1] < 0.25 || x[1] > 1.75) continue;  // interior
+    EXPECT_NEAR(solver.node_stress()(i, StressComponent::xx), -5.0e4 + rate_xx * solver.dt(),
+                1e-6 * rate_xx * solver.dt());
+    EXPECT_NEAR(solver.node_stress()(i, StressComponent::zz), -5.0e4 + rate_zz * solver.dt(),
+                1e-6 * rate_zz * solver.dt());
+    ++checked;
+  }
+  EXPECT_GT(checked, 20);
+}
+
 TEST(UniformInitialStress, UnknownTypeAndConditionIn2DAreErrors) {
   std::string bad = kSample2D;
   bad.replace(bad.find("spacing = 0.1"), 13, "spacing = 0.1\ncondition = \"uniaxial_stress\"");
@@ -146,6 +181,41 @@ cfl = 0.5
   const std::size_t mid = 5;
   EXPECT_NEAR(solver.node_stress()(mid, StressComponent::xx), 1.0e7 * 1e-3 * solver.dt(),
               1e-6 * 1.0e7 * 1e-3 * solver.dt());
+}
+
+// The 1D bar's uniaxial-stress wrapper uses the constant E: pressure-dependent moduli are refused.
+TEST(UniaxialStressCondition, RefusesPressureDependentElasticity) {
+  const std::string bar = R"(
+[geometry]
+dimension = 1
+spacing = 0.1
+condition = "uniaxial_stress"
+[[geometry.block]]
+min = [0.0]
+max = [1.0]
+[material]
+model = "perzyna_cam_clay"
+elasticity = "pressure_dependent"
+nu = 0.3
+density = 2000.0
+M = 1.2
+lambda = 0.2
+kappa = 0.02
+e0 = 1.0
+p_c0 = 4.0e5
+fluidity = 10.0
+elastic_p_min = 1.0e3
+elastic_p_max = 1.0e6
+[time]
+end = 1.0
+cfl = 0.5
+)";
+  try {
+    setup_from<1>(bar, "barpd");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("pressure-dependent elasticity"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
