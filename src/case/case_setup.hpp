@@ -123,6 +123,16 @@ struct CaseSetup {
   double dx = 0.0;
   Vec<Dim> origin = Vec<Dim>::Zero();
   std::vector<Block<Dim>> blocks;
+  /// geometry.jitter and geometry.jitter_seed (particles/lattice.hpp, LatticeJitter).
+  LatticeJitter jitter;
+  /// geometry.particles: nodes and stress points read from files (case/particle_file_reader.hpp)
+  /// instead of generated from blocks. They lie on no lattice face (BoundaryNodes stays empty):
+  /// the free surface must be detected (solver.free_surface = "detect", V2 in 2D).
+  struct ImportedParticles {
+    ParticleSet<Dim> nodes{"nodes"};
+    ParticleSet<Dim> stress_points{"stress_points"};
+  };
+  std::optional<ImportedParticles> imported;
   /// 1D: uniaxial strain (lateral strains zero; modulus lambda + 2G) or uniaxial stress
   /// (lateral stresses zero; modulus E, materials wrapped by UniaxialStressMaterial).
   BarCondition condition = BarCondition::uniaxial_strain;
@@ -180,7 +190,7 @@ struct CaseSetup {
   SourceCoupling coupling = SourceCoupling::additive;
 
   // output
-  double output_interval = 0.0;      // s; 0 = first and last state only
+  double output_interval = 0.0;  // s; 0 = first and last state only
   /// s of simulated time between checkpoints; empty = a tenth of the run; 0 = none but the one
   /// written when the run is interrupted (docs/output.md, "Interrupted runs").
   std::optional<double> checkpoint_interval;
