@@ -98,7 +98,15 @@ typename CaseSetup<Dim>::ImportedParticles read_imported_particles(const CaseDoc
       if (path.is_relative() && !doc.directory.empty()) path = std::filesystem::path(doc.directory) / path;
       const bool nodes = std::string_view(key) == "nodes";
       auto& set = nodes ? out.nodes : out.stress_points;
-      const auto lines = read_particle_file<Dim>(path.string(), name, e.where(key), materials, set);
+      bool faces_given = false;
+      const auto lines = read_particle_file<Dim>(path.string(), name, e.where(key), materials, set,
+                                                 nodes ? &out.boundary : nullptr, &faces_given);
+      if (nodes && k > 0 && faces_given != out.faces_given) {
+        e.fail(key, fmt::format("{} {} the face columns and geometry.particles[0].nodes {}: give them in every "
+                                "node file or in none",
+                                name, faces_given ? "has" : "lacks", out.faces_given ? "has" : "does not"));
+      }
+      if (nodes) out.faces_given = faces_given;
       for (const long line : lines) (nodes ? node_origin : stress_point_origin).push_back({k, line});
       (nodes ? node_file : stress_point_file).push_back(name);
     }
@@ -463,12 +471,13 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     s->finish();
   }
 
-  // Particles from files lie on no lattice face: nothing would make their surface traction-free
-  // but its detection (docs/case-format.md, "Particles from files").
-  if (c.imported && !c.detect_free_surface) {
+  // Particles from files without their faces lie on no face: nothing would make their surface
+  // traction-free but its detection (docs/case-format.md, "Particles from files").
+  if (c.imported && !c.imported->faces_given && !c.detect_free_surface) {
     throw InputError(
-        fmt::format("{}: particles from files lie on no lattice face, so their traction-free surface must be detected: "
-                    "use solver.version = \"v2\" in 2D with solver.free_surface = \"detect\" (its default)",
+        fmt::format("{}: particles from files without the face columns lie on no lattice face, so their "
+                    "traction-free surface must be detected: use solver.version = \"v2\" in 2D with "
+                    "solver.free_surface = \"detect\" (its default), or give the nodes' faces (face_-x, face_+x, ...)",
                     particles_where));
   }
 

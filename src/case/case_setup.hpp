@@ -126,11 +126,14 @@ struct CaseSetup {
   /// geometry.jitter and geometry.jitter_seed (particles/lattice.hpp, LatticeJitter).
   LatticeJitter jitter;
   /// geometry.particles: nodes and stress points read from files (case/particle_file_reader.hpp)
-  /// instead of generated from blocks. They lie on no lattice face (BoundaryNodes stays empty):
-  /// the free surface must be detected (solver.free_surface = "detect", V2 in 2D).
+  /// instead of generated from blocks. Without the face columns the nodes lie on no face
+  /// (`boundary` stays empty) and the free surface must be detected (solver.free_surface =
+  /// "detect", V2 in 2D); with them, `boundary` holds the faces as a lattice would.
   struct ImportedParticles {
     ParticleSet<Dim> nodes{"nodes"};
     ParticleSet<Dim> stress_points{"stress_points"};
+    BoundaryNodes<Dim> boundary;
+    bool faces_given = false;
   };
   std::optional<ImportedParticles> imported;
   /// 1D: uniaxial strain (lateral strains zero; modulus lambda + 2G) or uniaxial stress

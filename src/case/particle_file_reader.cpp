@@ -1,6 +1,7 @@
 #include "case/particle_file_reader.hpp"
 
 #include <algorithm>
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <fstream>
@@ -41,9 +42,14 @@ bool blank_or_comment(const std::string& line) {
 
 }  // namespace
 
+std::string face_column_name(std::size_t side) {
+  return fmt::format("face_{}{}", side % 2 == 0 ? '-' : '+', kAxisNames[side / 2]);
+}
+
 template <int Dim>
 std::vector<long> read_particle_file(const std::string& path, const std::string& label, const std::string& where,
-                                     const ParticleFileMaterials& materials, ParticleSet<Dim>& set) {
+                                     const ParticleFileMaterials& materials, ParticleSet<Dim>& set,
+                                     BoundaryNodes<Dim>* faces, bool* faces_given) {
   auto fail = [&](long line, const std::string& column, const std::string& message) {
     throw InputError(fmt::format("{}: {}, line {}{}: {}", where, label, line,
                                  column.empty() ? std::string() : fmt::format(", column '{}'", column), message));
@@ -67,14 +73,19 @@ std::vector<long> read_particle_file(const std::string& path, const std::string&
   std::vector<std::string> accepted;
   for (int d = 0; d < Dim; ++d) accepted.emplace_back(kAxisNames[static_cast<std::size_t>(d)]);
   accepted.insert(accepted.end(), {"volume", "material", "density"});
-  constexpr std::size_t kDensity = Dim + 2;         // the optional column
+  constexpr std::size_t kDensity = Dim + 2;  // the optional columns: density, then the faces
+  constexpr std::size_t kFirstFace = Dim + 3;
+  if (faces != nullptr) {
+    for (std::size_t side = 0; side < 2 * Dim; ++side) accepted.push_back(face_column_name(side));
+  }
   std::vector<int> column_of(accepted.size(), -1);  // accepted name -> column index
   for (std::size_t k = 0; k < header.size(); ++k) {
     const auto it = std::find(accepted.begin(), accepted.end(), header[k]);
     if (it == accepted.end()) {
       fail(line, header[k],
-           fmt::format("unknown column{} (a {}D particle file has the columns {}; density is optional)",
-                       header[k].empty() ? " (an empty name)" : "", Dim, fmt::join(accepted, ", ")));
+           fmt::format("unknown column{} (a {}D {} file has the columns {}; {} optional)",
+                       header[k].empty() ? " (an empty name)" : "", Dim, faces != nullptr ? "node" : "stress-point",
+                       fmt::join(accepted, ", "), faces != nullptr ? "density and the faces are" : "density is"));
     }
     const auto a = static_cast<std::size_t>(it - accepted.begin());
     if (column_of[a] >= 0) fail(line, header[k], "appears twice in the header");
@@ -86,6 +97,20 @@ std::vector<long> read_particle_file(const std::string& path, const std::string&
            fmt::format("missing from the header '{}' (needed: {})", trimmed(text),
                        fmt::join(accepted.begin(), accepted.begin() + static_cast<std::ptrdiff_t>(kDensity), ", ")));
     }
+  }
+
+  // The faces: every face column or none.
+  bool with_faces = false;
+  if (faces != nullptr) {
+    for (std::size_t a = kFirstFace; a < accepted.size(); ++a) with_faces = with_faces || column_of[a] >= 0;
+    for (std::size_t a = kFirstFace; a < accepted.size() && with_faces; ++a) {
+      if (column_of[a] < 0) {
+        fail(line, accepted[a],
+             fmt::format("missing from the header: the face columns come all together ({})",
+                         fmt::join(accepted.begin() + static_cast<std::ptrdiff_t>(kFirstFace), accepted.end(), ", ")));
+      }
+    }
+    *faces_given = with_faces;
   }
 
   auto number = [&](const std::vector<std::string>& fields, std::size_t a) {
@@ -127,6 +152,24 @@ std::vector<long> read_particle_file(const std::string& path, const std::string&
       density = number(fields, kDensity);
       if (!(density > 0.0)) fail(line, "density", fmt::format("must be > 0 (kg/m^3), got {}", density));
     }
+    if (with_faces) {
+      std::uint8_t bits = 0;
+      std::array<double, 2 * Dim> area{};
+      for (std::size_t side = 0; side < 2 * Dim; ++side) {
+        area[side] = number(fields, kFirstFace + side);
+        if (!(area[side] >= 0.0)) {
+          fail(line, accepted[kFirstFace + side],
+               fmt::format("must be >= 0 (the node's area of that face, m^{}; 0 = not on it), got {}", Dim - 1,
+                           area[side]));
+        }
+        if (area[side] > 0.0) bits = static_cast<std::uint8_t>(bits | (1u << side));
+      }
+      if (bits != 0) {
+        faces->node.push_back(set.size());
+        faces->faces.push_back(bits);
+        faces->area.push_back(area);
+      }
+    }
     set.add(x, volume, density, static_cast<int>(material));
     lines.push_back(line);
   }
@@ -156,9 +199,10 @@ std::pair<Index, Index> coincident_particles(const ParticleSet<Dim>& set, double
   return {-1, -1};
 }
 
-#define RKTSPH_PARTICLE_FILE(D)                                                                                \
-  template std::vector<long> read_particle_file<D>(const std::string&, const std::string&, const std::string&, \
-                                                   const ParticleFileMaterials&, ParticleSet<D>&);             \
+#define RKTSPH_PARTICLE_FILE(D)                                                                                      \
+  template std::vector<long> read_particle_file<D>(const std::string&, const std::string&, const std::string&,       \
+                                                   const ParticleFileMaterials&, ParticleSet<D>&, BoundaryNodes<D>*, \
+                                                   bool*);                                                           \
   template std::pair<Index, Index> coincident_particles<D>(const ParticleSet<D>&, double);
 RKTSPH_PARTICLE_FILE(1)
 RKTSPH_PARTICLE_FILE(2)

@@ -68,15 +68,16 @@ StaggeredModel<Dim>::StaggeredModel(CaseSetup<Dim> case_setup, exec::Threads thr
 
   LatticeParticles<Dim> lat;
   if (setup.imported) {
-    // Particles from files (geometry.particles): on no lattice face, so the free surface must
-    // be detected (the case reader says so at the key; this is for setups made in code).
-    if (!setup.detect_free_surface) {
+    // Particles from files (geometry.particles): without their faces the free surface must be
+    // detected (the case reader says so at the key; this is for setups made in code).
+    if (!setup.imported->faces_given && !setup.detect_free_surface) {
       throw InputError(
           fmt::format("{}: particles from files need solver.free_surface = \"detect\" (V2 in 2D)", setup.file));
     }
     lat.dx = setup.dx;
     lat.nodes = setup.imported->nodes;
     lat.stress_points = setup.imported->stress_points;
+    lat.boundary = setup.imported->boundary;
   } else {
     lat = generate_lattice<Dim>(setup.blocks, setup.dx, setup.origin, densities, setup.jitter);
   }

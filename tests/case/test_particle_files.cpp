@@ -67,13 +67,19 @@ stress_points = "{}"
          kMaterialAndLoads;
 }
 
-// The set as CSV, with every double written to round trip exactly.
-std::string csv_of(const ParticleSet<2>& set, bool with_density) {
-  std::string out = with_density ? "x,y,volume,material,density\n" : "x,y,volume,material\n";
+// The set as CSV, with every double written to round trip exactly; with `faces`, the nodes'
+// face areas too.
+std::string csv_of(const ParticleSet<2>& set, bool with_density, const BoundaryNodes<2>* faces = nullptr) {
+  std::string out = with_density ? "x,y,volume,material,density" : "x,y,volume,material";
+  out += faces != nullptr ? ",face_-x,face_+x,face_-y,face_+y\n" : "\n";
   for (Index i = 0; i < set.size(); ++i) {
     const auto u = static_cast<std::size_t>(i);
     out += fmt::format("{:.17g},{:.17g},{:.17g},material", set.position[u][0], set.position[u][1], set.volume[u]);
-    out += with_density ? fmt::format(",{:.17g}\n", set.density[u]) : "\n";
+    if (with_density) out += fmt::format(",{:.17g}", set.density[u]);
+    if (faces != nullptr) {
+      for (const double a : faces->area_of(i)) out += fmt::format(",{:.17g}", a);
+    }
+    out += "\n";
   }
   return out;
 }
@@ -119,6 +125,79 @@ TEST(ParticleFiles, ALatticeWrittenOutIsTheBlockCaseBitForBit) {
   EXPECT_GT(largest_stress, 100.0);
   std::printf("%ld V2 steps: largest settlement %.4g m, largest |syy| %.4g Pa, identical in both runs\n",
               blocks.step_count(), largest, largest_stress);
+}
+
+// V1 on a plate with plane boundary entries, a partial load and free faces: with the nodes'
+// faces in the file, the lattice's face rules, segment averaging and traction work all hold.
+std::string plate_case(const std::string& geometry) {
+  return R"(title = "loaded plate"
+[geometry]
+dimension = 2
+spacing = 0.25
+)" + geometry +
+         R"(
+[material]
+model = "elastic"
+E = 1.0e7
+nu = 0.3
+density = 2000.0
+[[boundary]]
+name = "base"
+y = [0.0, 0.0]
+velocity = { x = 0.0, y = 0.0 }
+[[boundary]]
+name = "left wall"
+x = [0.0, 0.0]
+velocity = { x = 0.0 }
+[[boundary]]
+name = "footing"
+x = [0.0, 0.6]
+y = [1.0, 1.0]
+stress = { yy = -2.0e4 }
+function = "load"
+[functions.load]
+type = "smoothstep"
+duration = 0.01
+[time]
+end = 0.03
+cfl = 0.5
+)";
+}
+
+TEST(ParticleFiles, NodesWithTheirFacesRunAsTheBlockCaseInV1) {
+  const test::ThreadCount threads(1);
+  test::TempDir dir;
+  Simulation<2> blocks(test::case_from_string<2>(
+      dir, plate_case("[[geometry.block]]\nmin = [0.0, 0.0]\nmax = [2.0, 1.0]\n"), {}, "blocks.toml"));
+  dir.write("nodes.csv", csv_of(blocks.nodes(), false, &blocks.model().boundary));
+  dir.write("sp.csv", csv_of(blocks.stress_points(), false));
+  Simulation<2> files(test::case_from_string<2>(
+      dir, plate_case("[[geometry.particles]]\nnodes = \"nodes.csv\"\nstress_points = \"sp.csv\"\n"), {},
+      "files.toml"));
+  expect_same_set(blocks.nodes(), files.nodes());
+  expect_same_set(blocks.stress_points(), files.stress_points());
+  const auto& a = blocks.model().boundary;
+  const auto& b = files.model().boundary;
+  EXPECT_EQ(a.node, b.node);
+  EXPECT_EQ(a.faces, b.faces);
+  EXPECT_EQ(a.area, b.area);
+  EXPECT_EQ(blocks.model().constraints.constrained(), files.model().constraints.constrained());
+  while (blocks.time() < 0.03 - 1e-12) {
+    blocks.step();
+    files.step();
+  }
+  ASSERT_EQ(blocks.step_count(), files.step_count());
+  double largest = 0.0;
+  for (Index i = 0; i < blocks.nodes().size(); ++i) {
+    for (const StressComponent c : {StressComponent::xx, StressComponent::yy, StressComponent::zz, StressComponent::xy})
+      EXPECT_EQ(blocks.node_stress()(i, c), files.node_stress()(i, c)) << "node " << i;
+    for (int d = 0; d < 2; ++d) EXPECT_EQ(blocks.node_displacement()(i, d), files.node_displacement()(i, d));
+    largest = std::max(largest, std::abs(blocks.node_displacement()(i, 1)));
+  }
+  EXPECT_EQ(blocks.clock().external_work(), files.clock().external_work());
+  EXPECT_GT(largest, 1e-5);
+  std::printf("%ld V1 steps: largest settlement %.4g m, external work %.4g J/m, identical in both runs\n",
+              blocks.step_count(), largest, blocks.clock().external_work());
 }
 
 TEST(ParticleFiles, PathsAreRelativeToTheCaseFile) {
@@ -279,6 +358,23 @@ TEST(ParticleFiles, BadFilesNameTheFileLineAndColumn) {
     SCOPED_TRACE(b.what);
     const auto o = run(dir, small_case(), b.csv, kStressPoints);
     expect_error(o, key, kNodesLine, b.also);
+  }
+  // The face columns: all or none, not negative, and only in a node file.
+  {
+    const auto o = run(dir, small_case(), "x,y,volume,material,face_-x,face_+x,face_-y\n0,0,0.25,material,0.5,0,0.5\n",
+                       kStressPoints);
+    expect_error(o, key, kNodesLine, {"nodes.csv, line 1, column 'face_+y'", "all together"});
+  }
+  {
+    const auto o =
+        run(dir, small_case(), "x,y,volume,material,face_-x,face_+x,face_-y,face_+y\n0,0,0.25,material,0.5,0,-0.5,0\n",
+            kStressPoints);
+    expect_error(o, key, kNodesLine, {"nodes.csv, line 2, column 'face_-y'", "must be >= 0", "got -0.5"});
+  }
+  {
+    const auto o = run(dir, small_case(), kNodes, "x,y,volume,material,face_-x\n0.5,0.5,1.0,material,0\n");
+    expect_error(o, "geometry.particles[0].stress_points", kStressPointsLine,
+                 {"sp.csv, line 1, column 'face_-x'", "unknown column"});
   }
   // The density column, when given, is checked like the volume.
   {
