@@ -308,6 +308,33 @@ TEST(ParticleFiles, AGoodCaseRuns) {
   }
 }
 
+// A resumed run reads the particle files again from beside the original case file (not from
+// the working folder), and refuses files that have changed since the checkpoint.
+TEST(ParticleFiles, AResumedRunReadsTheFilesBesideTheCaseFile) {
+  test::TempDir dir;
+  std::filesystem::create_directories(dir.path() / "case");
+  const auto [nodes, stress_points] = lattice_files(0.25);
+  dir.write("case/nodes.csv", nodes);
+  dir.write("case/sp.csv", stress_points);
+  const std::string file = dir.write("case/case.toml", small_case("version = \"v2\"", 0.25));
+  const std::string bin = RKTSPH_BINARY;
+  auto command = [&](const std::string& args) {
+    // From the root folder: a path resolved against the working folder would not be found.
+    return test::run_command(fmt::format("cd / && \"{}\" {} -q 2>&1", bin, args));
+  };
+  auto r = command(fmt::format("run \"{}\" --out \"{}\" --set time.end=0.01", file, dir.file("run")));
+  ASSERT_EQ(r.status, 0) << r.out;
+  r = command(fmt::format("resume \"{}\" --set time.end=0.02", dir.file("run")));
+  EXPECT_EQ(r.status, 0) << r.out;
+  EXPECT_NE(test::read_text(dir.file("run/summary.json")).find("\"time\": 0.02"), std::string::npos)
+      << test::read_text(dir.file("run/summary.json"));
+  std::string changed = nodes;
+  changed.replace(changed.find(",0.015625,"), 10, ",0.015626,");  // one corner's volume
+  dir.write("case/nodes.csv", changed);
+  r = command(fmt::format("resume \"{}\" --set time.end=0.03", dir.file("run")));
+  EXPECT_EQ(r.status, 2) << r.out;
+}
+
 TEST(ParticleFiles, BadFilesNameTheFileLineAndColumn) {
   test::TempDir dir;
   const std::string key = "geometry.particles[0].nodes";
