@@ -193,7 +193,7 @@ struct CaseSetup {
   SourceCoupling coupling = SourceCoupling::additive;
 
   // output
-  double output_interval = 0.0;  // s; 0 = first and last state only
+  double output_interval = 0.0;      // s; 0 = first and last state only
   /// s of simulated time between checkpoints; empty = a tenth of the run; 0 = none but the one
   /// written when the run is interrupted (docs/output.md, "Interrupted runs").
   std::optional<double> checkpoint_interval;

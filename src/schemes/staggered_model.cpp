@@ -72,7 +72,9 @@ StaggeredModel<Dim>::StaggeredModel(CaseSetup<Dim> case_setup, exec::Threads thr
     // detected (the case reader says so at the key; this is for setups made in code).
     if (!setup.imported->faces_given && !setup.detect_free_surface) {
       throw InputError(
-          fmt::format("{}: particles from files need solver.free_surface = \"detect\" (V2 in 2D)", setup.file));
+          fmt::format("{}: particles from files without their faces need solver.free_surface = \"detect\" "
+                      "(V2 in 2D)",
+                      setup.file));
     }
     lat.dx = setup.dx;
     lat.nodes = setup.imported->nodes;

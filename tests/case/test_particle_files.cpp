@@ -306,6 +306,10 @@ TEST(ParticleFiles, AGoodCaseRuns) {
     EXPECT_NEAR(volume, 2.0, 1e-12);
     for (const double rho : set->density) EXPECT_EQ(rho, 2000.0);
   }
+  // A setup changed in code is checked by the model as the reader checks a file.
+  auto without_detection = setup;
+  without_detection.detect_free_surface = false;
+  EXPECT_THROW(StaggeredModel<2>{without_detection}, InputError);
 }
 
 // A resumed run reads the particle files again from beside the original case file (not from
