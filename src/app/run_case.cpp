@@ -142,6 +142,9 @@ int resume_case(const RunOptions& opt) {
   input.options.case_file = checkpoint.text("case/file");
   input.document = parse_case_document(checkpoint.text("case/document"),
                                        fmt::format("{} (the case of the checkpoint)", file.string()), opt.overrides);
+  // Particle files are read again from beside the original case file; the particles'
+  // fingerprint in the checkpoint tells whether they are still the same.
+  input.document.directory = std::filesystem::path(input.options.case_file).parent_path().string();
   if (case_dimension(input.document) != checkpoint.integer("case/dimension")) {
     throw InputError(fmt::format("{}: a damaged checkpoint (its case and its state disagree on the dimension)",
                                  file.string()));

@@ -55,6 +55,11 @@ class CaseBuilder {
     blocks_.push_back({min, max, material});
     return *this;
   }
+  /// geometry.jitter: interior particles displaced by up to `fraction` spacings (LatticeJitter).
+  CaseBuilder& jitter(double fraction, std::uint64_t seed = 0) {
+    c_.jitter = {fraction, seed};
+    return *this;
+  }
   CaseBuilder& material(std::shared_ptr<const Material> model, const std::string& name = "material") {
     c_.material_names.push_back(name);
     c_.materials.push_back(std::move(model));
@@ -169,6 +174,8 @@ class CaseBuilder {
     if (c.detect_free_surface && (c.version != "v2" || Dim < 2))
       fail("free-surface detection needs the V2 scheme in 2D or 3D");
     if (!(c.dx > 0.0)) fail("the spacing must be > 0");
+    if (!(c.jitter.fraction >= 0.0 && c.jitter.fraction < kMaxJitterFraction))
+      fail(fmt::format("the jitter must lie in [0, {}) spacings", kMaxJitterFraction));
     if (c.materials.empty()) fail("no material");
     if (blocks_.empty()) fail("no block");
     if (!(c.end_time > 0.0)) fail("the end time must be > 0");

@@ -1,6 +1,7 @@
 // A case file as a TOML document: parsing, the command-line overrides (--set key=value), the
 // dimension of space, and the time-function tables (docs/case-format.md).
 #include <algorithm>
+#include <filesystem>
 #include <fstream>
 #include <optional>
 #include <sstream>
@@ -163,7 +164,9 @@ CaseDocument load_case_document(const std::string& file, const std::vector<std::
   if (!in) throw InputError(fmt::format("{}: cannot open the case file", file));
   std::stringstream buffer;
   buffer << in.rdbuf();
-  return parse_case_document(buffer.str(), file, overrides);
+  CaseDocument doc = parse_case_document(buffer.str(), file, overrides);
+  doc.directory = std::filesystem::path(file).parent_path().string();
+  return doc;
 }
 
 CaseDocument parse_case_document(const std::string& text, const std::string& label,

@@ -2,6 +2,7 @@
 // the line and the key, and is an InputError (exit status 2).
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <limits>
@@ -12,6 +13,7 @@
 
 #include "case/case_reader.hpp"
 #include "case/material_reader.hpp"
+#include "case/particle_file_reader.hpp"
 #include "case/size_limits.hpp"
 #include "core/error.hpp"
 #include "io/section.hpp"
@@ -69,6 +71,67 @@ int material_index(const std::vector<std::string>& names, const io::Section& s, 
   s.fail(key, fmt::format("no material named '{}' (defined: {})", name, fmt::join(names, ", ")));
 }
 
+// [[geometry.particles]]: each entry names a CSV file of nodes and one of stress points
+// (case/particle_file_reader.hpp), relative to the case file's folder; the entries' particles
+// make one set each. No two particles of a set may coincide (within 1e-6 spacings, the
+// tolerance with which boundary entries select nodes).
+template <int Dim>
+typename CaseSetup<Dim>::ImportedParticles read_imported_particles(const CaseDocument& doc,
+                                                                   const std::vector<io::Section>& entries,
+                                                                   const CaseSetup<Dim>& c) {
+  ParticleFileMaterials materials;
+  materials.names = c.material_names;
+  for (const auto& m : c.materials) materials.densities.push_back(m->density());
+  typename CaseSetup<Dim>::ImportedParticles out;
+  struct Origin {
+    std::size_t entry;
+    long line;
+  };
+  std::vector<Origin> node_origin, stress_point_origin;
+  std::vector<std::string> node_file, stress_point_file;
+  for (std::size_t k = 0; k < entries.size(); ++k) {
+    const io::Section& e = entries[k];
+    for (const char* key : {"nodes", "stress_points"}) {
+      const std::string name = e.string(key);
+      e.require(!name.empty(), key, "must name a CSV file");
+      std::filesystem::path path(name);
+      if (path.is_relative() && !doc.directory.empty()) path = std::filesystem::path(doc.directory) / path;
+      const bool nodes = std::string_view(key) == "nodes";
+      auto& set = nodes ? out.nodes : out.stress_points;
+      bool faces_given = false;
+      const auto lines = read_particle_file<Dim>(path.string(), name, e.where(key), materials, set,
+                                                 nodes ? &out.boundary : nullptr, &faces_given);
+      if (nodes && k > 0 && faces_given != out.faces_given) {
+        e.fail(key, fmt::format("{} {} the face columns and geometry.particles[0].nodes {}: give them in every "
+                                "node file or in none",
+                                name, faces_given ? "has" : "lacks", out.faces_given ? "has" : "does not"));
+      }
+      if (nodes) out.faces_given = faces_given;
+      for (const long line : lines) (nodes ? node_origin : stress_point_origin).push_back({k, line});
+      (nodes ? node_file : stress_point_file).push_back(name);
+    }
+    e.finish();
+  }
+  const double tolerance = 1e-6 * c.dx;
+  for (const char* key : {"nodes", "stress_points"}) {
+    const bool nodes = std::string_view(key) == "nodes";
+    const auto& set = nodes ? out.nodes : out.stress_points;
+    const auto& origin = nodes ? node_origin : stress_point_origin;
+    const auto& file = nodes ? node_file : stress_point_file;
+    const auto [a, b] = coincident_particles<Dim>(set, tolerance);
+    if (a < 0) continue;
+    const Origin& first = origin[static_cast<std::size_t>(a)];
+    const Origin& second = origin[static_cast<std::size_t>(b)];
+    std::vector<double> x(set.position[static_cast<std::size_t>(b)].data(),
+                          set.position[static_cast<std::size_t>(b)].data() + Dim);
+    entries[second.entry].fail(key, fmt::format("{}, line {}: the particle at ({}) coincides with the one of {}, line "
+                                                "{} (closer than 1e-6 spacings, {:.3g} m)",
+                                                file[second.entry], second.line, fmt::join(x, ", "), file[first.entry],
+                                                first.line, tolerance));
+  }
+  return out;
+}
+
 }  // namespace
 
 template <int Dim>
@@ -110,6 +173,7 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
 
   // ---- geometry (the section is kept: the memory estimate below names its spacing)
   const io::Section g = root.table("geometry");
+  std::string particles_where;  // the first [[geometry.particles]], for the checks below
   {
     g.integer("dimension");
     c.dx = g.positive("spacing");
@@ -130,8 +194,30 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
       c.origin = read_vector<Dim>(g, "origin");
     else
       g.number("origin", 0.0);
+    // Disordered lattices (particles/lattice.hpp, LatticeJitter): below half a spacing.
+    c.jitter.fraction = g.non_negative("jitter", 0.0);
+    g.require(c.jitter.fraction < kMaxJitterFraction, "jitter",
+              fmt::format("must lie in [0, {}) spacings (at half a spacing a particle can reach its "
+                          "neighbour's place or a face), got {}",
+                          kMaxJitterFraction, c.jitter.fraction));
+    const std::int64_t seed = g.integer("jitter_seed", 0);
+    g.require(seed >= 0, "jitter_seed", fmt::format("must be >= 0, got {}", seed));
+    c.jitter.seed = static_cast<std::uint64_t>(seed);
     const auto blocks = g.tables("block");
-    if (blocks.empty()) g.fail("block", "missing: the geometry needs at least one [[geometry.block]]");
+    const auto particle_files = g.tables("particles");
+    if (!blocks.empty() && !particle_files.empty()) {
+      particle_files.front().fail("", "give either [[geometry.block]] or [[geometry.particles]], not both");
+    }
+    if (blocks.empty() && particle_files.empty()) {
+      g.fail("block", "missing: the geometry needs at least one [[geometry.block]] (or [[geometry.particles]])");
+    }
+    if (!particle_files.empty()) {
+      particles_where = particle_files.front().where();
+      if (c.jitter.fraction > 0.0) {
+        g.fail("jitter", "applies to lattices generated from [[geometry.block]], not to particles from files");
+      }
+      c.imported = read_imported_particles<Dim>(doc, particle_files, c);
+    }
     for (const io::Section& b : blocks) {
       Block<Dim> blk;
       blk.min = read_vector<Dim>(b, "min");
@@ -383,6 +469,16 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     else
       s->fail("source_coupling", fmt::format("unknown source coupling '{}' (known: additive, frozen_flux)", coupling));
     s->finish();
+  }
+
+  // Particles from files without their faces lie on no face: nothing would make their surface
+  // traction-free but its detection (docs/case-format.md, "Particles from files").
+  if (c.imported && !c.imported->faces_given && !c.detect_free_surface) {
+    throw InputError(
+        fmt::format("{}: particles from files without the face columns lie on no lattice face, so their "
+                    "traction-free surface must be detected: use solver.version = \"v2\" in 2D with "
+                    "solver.free_surface = \"detect\" (its default), or give the nodes' faces (face_-x, face_+x, ...)",
+                    particles_where));
   }
 
   // ---- V3: the pore fluid (docs/case-format.md, "Saturated soil (V3)")

@@ -19,6 +19,9 @@ class Section;
 struct CaseDocument {
   std::string file;
   std::shared_ptr<const std::string> file_label;
+  /// The folder that relative paths in the case (geometry.particles) start from: the case
+  /// file's own folder.
+  std::string directory;
   toml::table table;
 };
 

@@ -123,6 +123,19 @@ struct CaseSetup {
   double dx = 0.0;
   Vec<Dim> origin = Vec<Dim>::Zero();
   std::vector<Block<Dim>> blocks;
+  /// geometry.jitter and geometry.jitter_seed (particles/lattice.hpp, LatticeJitter).
+  LatticeJitter jitter;
+  /// geometry.particles: nodes and stress points read from files (case/particle_file_reader.hpp)
+  /// instead of generated from blocks. Without the face columns the nodes lie on no face
+  /// (`boundary` stays empty) and the free surface must be detected (solver.free_surface =
+  /// "detect", V2 in 2D); with them, `boundary` holds the faces as a lattice would.
+  struct ImportedParticles {
+    ParticleSet<Dim> nodes{"nodes"};
+    ParticleSet<Dim> stress_points{"stress_points"};
+    BoundaryNodes<Dim> boundary;
+    bool faces_given = false;
+  };
+  std::optional<ImportedParticles> imported;
   /// 1D: uniaxial strain (lateral strains zero; modulus lambda + 2G) or uniaxial stress
   /// (lateral stresses zero; modulus E, materials wrapped by UniaxialStressMaterial).
   BarCondition condition = BarCondition::uniaxial_strain;

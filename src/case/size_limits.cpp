@@ -119,6 +119,10 @@ SizeEstimate estimate_size(const CaseSetup<Dim>& c, bool saturated) {
     e.stress_points = std::min(e.stress_points, box_cells);
     e.nodes = std::min(e.nodes, box_nodes);
   }
+  if (c.imported) {  // particles from files: their counts, and no lattice
+    e.nodes = static_cast<double>(c.imported->nodes.size());
+    e.stress_points = static_cast<double>(c.imported->stress_points.size());
+  }
   e.bytes = e.nodes * bytes_per_node(Dim, saturated) + e.lattice_cells * static_cast<double>(sizeof(int));
   return e;
 }

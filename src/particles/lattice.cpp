@@ -60,12 +60,33 @@ void for_each_index(const std::array<int, Dim>& lo, const std::array<int, Dim>& 
   }
 }
 
+// SplitMix64 (Steele, Lea and Flood 2014): a bijective mix of 64 bits, good enough to make
+// independent uniform draws from a counter.
+std::uint64_t split_mix(std::uint64_t x) {
+  x += 0x9E3779B97F4A7C15ull;
+  x = (x ^ (x >> 30)) * 0xBF58476D1CE4E5B9ull;
+  x = (x ^ (x >> 27)) * 0x94D049BB133111EBull;
+  return x ^ (x >> 31);
+}
+
 }  // namespace
+
+double jitter_unit_offset(std::uint64_t seed, int set, Index index, int axis) {
+  std::uint64_t h = split_mix(seed);
+  h = split_mix(h ^ static_cast<std::uint64_t>(set));
+  h = split_mix(h ^ static_cast<std::uint64_t>(index));
+  h = split_mix(h ^ static_cast<std::uint64_t>(axis));
+  return 2.0 * (static_cast<double>(h >> 11) * 0x1.0p-53) - 1.0;  // the top 53 bits, in [-1, 1)
+}
 
 template <int Dim>
 LatticeParticles<Dim> generate_lattice(const std::vector<Block<Dim>>& blocks, double dx, const Vec<Dim>& origin,
-                                       const std::vector<double>& densities) {
+                                       const std::vector<double>& densities, const LatticeJitter& jitter) {
   if (blocks.empty()) throw InputError("the geometry has no block");
+  if (!(jitter.fraction >= 0.0 && jitter.fraction < kMaxJitterFraction)) {
+    throw InputError(
+        fmt::format("the jitter must lie in [0, {}) spacings, got {}", kMaxJitterFraction, jitter.fraction));
+  }
   LatticeParticles<Dim> out;
   out.dx = dx;
   Lattice<Dim>& lat = out.lattice;
@@ -190,6 +211,24 @@ LatticeParticles<Dim> generate_lattice(const std::vector<Block<Dim>>& blocks, do
     }
     out.nodes.add(x, volume, mass / volume, material);  // density mass-weighted at material interfaces
   });
+
+  if (jitter.fraction > 0.0) {
+    const double amplitude = jitter.fraction * dx;
+    for (Index e = 0; e < out.stress_points.size(); ++e) {
+      for (int d = 0; d < Dim; ++d)
+        out.stress_points.position[static_cast<std::size_t>(e)][d] +=
+            amplitude * jitter_unit_offset(jitter.seed, 1, e, d);
+    }
+    std::size_t next_face = 0;  // boundary.node is ascending
+    for (Index i = 0; i < out.nodes.size(); ++i) {
+      if (next_face < out.boundary.node.size() && out.boundary.node[next_face] == i) {
+        ++next_face;
+        continue;
+      }
+      for (int d = 0; d < Dim; ++d)
+        out.nodes.position[static_cast<std::size_t>(i)][d] += amplitude * jitter_unit_offset(jitter.seed, 0, i, d);
+    }
+  }
   return out;
 }
 
@@ -197,10 +236,10 @@ template struct Lattice<1>;
 template struct Lattice<2>;
 template struct Lattice<3>;
 template LatticeParticles<1> generate_lattice<1>(const std::vector<Block<1>>&, double, const Vec<1>&,
-                                                 const std::vector<double>&);
+                                                 const std::vector<double>&, const LatticeJitter&);
 template LatticeParticles<2> generate_lattice<2>(const std::vector<Block<2>>&, double, const Vec<2>&,
-                                                 const std::vector<double>&);
+                                                 const std::vector<double>&, const LatticeJitter&);
 template LatticeParticles<3> generate_lattice<3>(const std::vector<Block<3>>&, double, const Vec<3>&,
-                                                 const std::vector<double>&);
+                                                 const std::vector<double>&, const LatticeJitter&);
 
 }  // namespace rktsph

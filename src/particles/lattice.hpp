@@ -82,6 +82,24 @@ struct BoundaryNodes {
   }
 };
 
+/// geometry.jitter: a random displacement of the generated particles, for tests of the operators
+/// on disordered sets. Every stress point and every node on no face of the body moves by an
+/// offset drawn uniformly from [-fraction dx, fraction dx]^Dim; face nodes (BoundaryNodes) stay
+/// where they are, so boundary entries select them and their faces and areas still hold.
+/// Volumes do not change. The offsets are a hash of (seed, set, particle index, axis): the
+/// same seed gives the same particles on any thread count.
+struct LatticeJitter {
+  double fraction = 0.0;  // of the spacing; 0 = none
+  std::uint64_t seed = 0;
+};
+/// The jitter must stay below half a spacing: then a stress point stays inside its cell and a
+/// node inside the half-spacing box around its lattice site, so that no two particles of a set
+/// can meet or swap and no interior node reaches a face.
+inline constexpr double kMaxJitterFraction = 0.5;
+
+/// The offset in [-1, 1) of particle `index` of set `set` (0 nodes, 1 stress points) along `axis`.
+double jitter_unit_offset(std::uint64_t seed, int set, Index index, int axis);
+
 template <int Dim>
 struct LatticeParticles {
   double dx = 0.0;
@@ -92,9 +110,10 @@ struct LatticeParticles {
 };
 
 /// Build nodes and stress points from blocks (all on one lattice of spacing dx starting at
-/// `origin`). Throws InputError naming the block if it is not aligned with the lattice.
+/// `origin`), displaced by `jitter`. Throws InputError naming the block if it is not aligned
+/// with the lattice, or if the jitter is not in [0, kMaxJitterFraction).
 template <int Dim>
 LatticeParticles<Dim> generate_lattice(const std::vector<Block<Dim>>& blocks, double dx, const Vec<Dim>& origin,
-                                       const std::vector<double>& densities);
+                                       const std::vector<double>& densities, const LatticeJitter& jitter = {});
 
 }  // namespace rktsph

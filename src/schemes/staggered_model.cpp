@@ -66,11 +66,27 @@ StaggeredModel<Dim>::StaggeredModel(CaseSetup<Dim> case_setup, exec::Threads thr
   }
   materials.history = HistoryLayout(materials.models);
 
-  LatticeParticles<Dim> lat = generate_lattice<Dim>(setup.blocks, setup.dx, setup.origin, densities);
+  LatticeParticles<Dim> lat;
+  if (setup.imported) {
+    // Particles from files (geometry.particles): without their faces the free surface must be
+    // detected (the case reader says so at the key; this is for setups made in code).
+    if (!setup.imported->faces_given && !setup.detect_free_surface) {
+      throw InputError(
+          fmt::format("{}: particles from files without their faces need solver.free_surface = \"detect\" "
+                      "(V2 in 2D)",
+                      setup.file));
+    }
+    lat.dx = setup.dx;
+    lat.nodes = setup.imported->nodes;
+    lat.stress_points = setup.imported->stress_points;
+    lat.boundary = setup.imported->boundary;
+  } else {
+    lat = generate_lattice<Dim>(setup.blocks, setup.dx, setup.origin, densities, setup.jitter);
+  }
   {
     // The memory estimate with the exact particle counts, before fields and operators.
     const SchemeInfo* scheme = find_scheme<Dim>(setup.version);
-    double cells = 1.0;
+    double cells = setup.imported ? 0.0 : 1.0;
     for (const int n : lat.lattice.cells) cells *= static_cast<double>(n);
     if (auto p = memory_problem(setup, scheme != nullptr && scheme->pore_fluid, static_cast<double>(lat.nodes.size()),
                                 static_cast<double>(lat.stress_points.size()), cells)) {

@@ -217,6 +217,24 @@ TEST(InputErrors, MisalignedBlock) {
   expect_error_at(o, line_of(text, "[[geometry.block]]"), "geometry.block[0]", {"lattice"});
 }
 
+TEST(InputErrors, JitterOfHalfASpacingOrMore) {
+  test::TempDir dir;
+  {
+    const std::string text = replace(kBase, "spacing = 0.5\n", "spacing = 0.5\njitter = 0.5\n");
+    const auto o = run_case_text(dir, text);
+    expect_error_at(o, line_of(text, "jitter"), "geometry.jitter", {"[0, 0.5)", "got 0.5"});
+  }
+  {
+    const std::string text = replace(kBase, "spacing = 0.5\n", "spacing = 0.5\njitter = 0.1\njitter_seed = -3\n");
+    const auto o = run_case_text(dir, text);
+    expect_error_at(o, line_of(text, "jitter_seed"), "geometry.jitter_seed", {">= 0"});
+  }
+  {
+    const std::string text = replace(kBase, "spacing = 0.5\n", "spacing = 0.5\njitter = 0.2\njitter_seed = 9\n");
+    EXPECT_EQ(run_case_text(dir, text).status, 0);
+  }
+}
+
 TEST(InputErrors, ProbeOutsideTheBody) {
   test::TempDir dir;
   const std::string text = replace(kBase, "position = [2.0, 1.0]", "position = [5.0, 1.0]");
