@@ -1,0 +1,180 @@
+// The readers of one boundary entry, one probe and the particle files
+// (case/case_reader_sections.hpp); every error names the file, the line and the key.
+#include "case/case_reader_sections.hpp"
+
+#include <filesystem>
+#include <limits>
+
+#include "case/particle_file_reader.hpp"
+#include "core/error.hpp"
+
+namespace rktsph::case_reading {
+
+template <int Dim>
+BoundarySpec<Dim> read_boundary(const io::Section& b, const CaseSetup<Dim>& c) {
+  BoundarySpec<Dim> spec;
+  spec.name = b.string("name", b.path());
+  spec.where = b.where();
+  bool any_axis = false;
+  for (int d = 0; d < Dim; ++d) {
+    const std::string axis(kAxisNames[static_cast<std::size_t>(d)]);
+    if (!b.has(axis)) {
+      b.number(axis, 0.0);
+      continue;
+    }
+    const auto range = b.numbers(axis);
+    if (range.size() != 2 || range[1] < range[0]) {
+      b.fail(axis, "must be a range [min, max] in m with min <= max (use [a, a] for a plane)");
+    }
+    spec.region.lo[static_cast<std::size_t>(d)] = range[0];
+    spec.region.hi[static_cast<std::size_t>(d)] = range[1];
+    spec.region.bounded[static_cast<std::size_t>(d)] = true;
+    any_axis = true;
+  }
+  if (!any_axis) {
+    b.fail("", fmt::format("selects no region: give at least one of {} as [min, max]", Dim == 1 ? "x" : "x, y"));
+  }
+  if (auto v = b.optional_table("velocity")) {
+    for (const std::string& axis : v->keys()) {
+      const int a = axis_of(axis);
+      if (a < 0 || a >= Dim) {
+        v->fail(axis, fmt::format("unknown velocity component (a {}D case has: {})", Dim, Dim == 1 ? "x" : "x, y"));
+      }
+      spec.velocity.emplace_back(a, v->number(axis));
+    }
+    v->finish();
+  }
+  if (auto st = b.optional_table("stress")) {
+    for (const std::string& comp : st->keys()) {
+      // Only the components that act on a face of the body can be prescribed.
+      const bool allowed = comp == "xx" || (Dim >= 2 && (comp == "yy" || comp == "xy"));
+      if (!allowed) {
+        st->fail(comp, fmt::format("not a stress component that can be prescribed in {}D "
+                                   "(use {})",
+                                   Dim, Dim == 1 ? "xx" : "xx, yy, xy"));
+      }
+      int slot = -1;
+      for (std::size_t i = 0; i < 6; ++i) {
+        if (kStressComponentNames[i] == comp) slot = stress_slot<Dim>(static_cast<StressComponent>(i));
+      }
+      spec.stress.emplace_back(slot, st->number(comp));
+    }
+    st->finish();
+  }
+  // V3 pore-pressure conditions (checked against solver.version below).
+  if (b.has("pore_pressure"))
+    spec.pore_pressure = b.number("pore_pressure");
+  else
+    b.number("pore_pressure", 0.0);
+  spec.impermeable = b.boolean("impermeable", false);
+  if (spec.pore_pressure && spec.impermeable) {
+    b.fail("impermeable", "a face is either drained (pore_pressure) or impermeable, not both");
+  }
+  if (spec.velocity.empty() && spec.stress.empty() && !spec.pore_pressure && !spec.impermeable) {
+    b.fail("",
+           "prescribes nothing: give a velocity = {...} or stress = {...} table (or, with "
+           "solver.version = \"v3\", pore_pressure or impermeable)");
+  }
+  spec.function = function_index(c, b, "function");
+  b.finish();
+  return spec;
+}
+
+template <int Dim>
+ProbeSpec read_probe(const io::Section& p, const CaseSetup<Dim>& c) {
+  ProbeSpec spec;
+  spec.name = p.string("name");
+  // The name heads columns of probes.csv ("name.field"): nothing that breaks a CSV header.
+  p.require(!spec.name.empty(), "name", "must not be empty (it heads the probe's columns in probes.csv)");
+  for (const char ch : spec.name) {
+    const auto u = static_cast<unsigned char>(ch);
+    if (ch == ',' || ch == '"' || u < 0x20 || u == 0x7f) {
+      p.fail("name", fmt::format("must not contain {} (the name heads the probe's columns in probes.csv)",
+                                 ch == ','   ? std::string("a comma")
+                                 : ch == '"' ? std::string("a double quote")
+                                             : fmt::format("a control character (code {})", static_cast<int>(u))));
+    }
+  }
+  spec.where = p.where("position");
+  spec.position = p.numbers("position");
+  if (static_cast<int>(spec.position.size()) != Dim) {
+    p.fail("position", fmt::format("must have {} coordinate{} for a {}D case", Dim, Dim > 1 ? "s" : "", Dim));
+  }
+  spec.fields = p.strings("fields");
+  p.require(!spec.fields.empty(), "fields", "must name at least one field");
+  for (const auto& other : c.probes) {
+    if (other.name == spec.name) p.fail("name", fmt::format("probe name '{}' is used twice", spec.name));
+  }
+  p.finish();
+  return spec;
+}
+
+template <int Dim>
+typename CaseSetup<Dim>::ImportedParticles read_imported_particles(const CaseDocument& doc,
+                                                                   const std::vector<io::Section>& entries,
+                                                                   const CaseSetup<Dim>& c) {
+  ParticleFileMaterials materials;
+  materials.names = c.material_names;
+  for (const auto& m : c.materials) materials.densities.push_back(m->density());
+  typename CaseSetup<Dim>::ImportedParticles out;
+  struct Origin {
+    std::size_t entry;
+    long line;
+  };
+  std::vector<Origin> node_origin, stress_point_origin;
+  std::vector<std::string> node_file, stress_point_file;
+  for (std::size_t k = 0; k < entries.size(); ++k) {
+    const io::Section& e = entries[k];
+    for (const char* key : {"nodes", "stress_points"}) {
+      const std::string name = e.string(key);
+      e.require(!name.empty(), key, "must name a CSV file");
+      std::filesystem::path path(name);
+      if (path.is_relative() && !doc.directory.empty()) path = std::filesystem::path(doc.directory) / path;
+      const bool nodes = std::string_view(key) == "nodes";
+      auto& set = nodes ? out.nodes : out.stress_points;
+      bool faces_given = false;
+      const auto lines = read_particle_file<Dim>(path.string(), name, e.where(key), materials, set,
+                                                 nodes ? &out.boundary : nullptr, &faces_given);
+      if (nodes && k > 0 && faces_given != out.faces_given) {
+        e.fail(key, fmt::format("{} {} the face columns and geometry.particles[0].nodes {}: give them in every "
+                                "node file or in none",
+                                name, faces_given ? "has" : "lacks", out.faces_given ? "has" : "does not"));
+      }
+      if (nodes) out.faces_given = faces_given;
+      for (const long line : lines) (nodes ? node_origin : stress_point_origin).push_back({k, line});
+      (nodes ? node_file : stress_point_file).push_back(name);
+    }
+    e.finish();
+  }
+  const double tolerance = 1e-6 * c.dx;
+  for (const char* key : {"nodes", "stress_points"}) {
+    const bool nodes = std::string_view(key) == "nodes";
+    const auto& set = nodes ? out.nodes : out.stress_points;
+    const auto& origin = nodes ? node_origin : stress_point_origin;
+    const auto& file = nodes ? node_file : stress_point_file;
+    const auto [a, b] = coincident_particles<Dim>(set, tolerance);
+    if (a < 0) continue;
+    const Origin& first = origin[static_cast<std::size_t>(a)];
+    const Origin& second = origin[static_cast<std::size_t>(b)];
+    std::vector<double> x(set.position[static_cast<std::size_t>(b)].data(),
+                          set.position[static_cast<std::size_t>(b)].data() + Dim);
+    entries[second.entry].fail(key, fmt::format("{}, line {}: the particle at ({}) coincides with the one of {}, line "
+                                                "{} (closer than 1e-6 spacings, {:.3g} m)",
+                                                file[second.entry], second.line, fmt::join(x, ", "), file[first.entry],
+                                                first.line, tolerance));
+  }
+  return out;
+}
+
+template BoundarySpec<1> read_boundary<1>(const io::Section&, const CaseSetup<1>&);
+template BoundarySpec<2> read_boundary<2>(const io::Section&, const CaseSetup<2>&);
+template ProbeSpec read_probe<1>(const io::Section&, const CaseSetup<1>&);
+template ProbeSpec read_probe<2>(const io::Section&, const CaseSetup<2>&);
+template CaseSetup<1>::ImportedParticles read_imported_particles<1>(const CaseDocument&,
+                                                                    const std::vector<io::Section>&,
+                                                                    const CaseSetup<1>&);
+template CaseSetup<2>::ImportedParticles read_imported_particles<2>(const CaseDocument&,
+                                                                    const std::vector<io::Section>&,
+                                                                    const CaseSetup<2>&);
+
+}  // namespace rktsph::case_reading
