@@ -564,6 +564,22 @@ TEST(DruckerPragerPerzyna, FastLimitConvergesAsOneOverFluidity) {
   EXPECT_LT(err[0] / err[1], 12.0);
 }
 
+// Plane-strain compression from the isotropic p0 to the end of `duration` s: the relative error
+// of the peak -sigma_yy against `expected` (below 1e-3), with sigma_zz the intermediate
+// principal stress (sigma_yy < sigma_zz < sigma_xx).
+double plane_strain_peak_error(const Material& m, double p0, double expected, double duration, double psi) {
+  LoadPath path = LoadPath::plane_strain_compression(-0.01);
+  path.duration = duration;
+  path.dt = 1e-3;
+  const PathResult r = integrate_path(m, {-p0, -p0, -p0, 0, 0, 0}, path);
+  const Sym6& end = r.points.back().stress;
+  const double err = std::abs(-end[1] - expected) / expected;
+  EXPECT_LT(err, 1e-3) << "psi " << psi << ": sigma_yy " << end[1];
+  EXPECT_LT(end[1], end[2]);
+  EXPECT_LT(end[2], end[0]);
+  return err;
+}
+
 // Plane-strain compression (sigma_xx = -p0 held, eps_zz = 0): with the plane-strain match of
 // eq. (1.10.5) the steady peak is the Mohr–Coulomb one, sigma_1 = p0 (1 + sin)/(1 - sin) +
 // 2 c cos/(1 - sin) (compression positive), for any dilatancy (method-notes eq. (1.10.10)).
@@ -574,17 +590,7 @@ TEST(DruckerPragerPerzyna, PlaneStrainPeakMatchesMohrCoulomb) {
   double worst = 0.0;
   for (double psi : {0.0, 15.0, 30.0}) {
     auto m = material_from_toml(drucker_prager("plane_strain", phi, psi, 20.0));
-    LoadPath path = LoadPath::plane_strain_compression(-0.01);
-    path.duration = 3.0;
-    path.dt = 1e-3;
-    const PathResult r = integrate_path(*m, {-p0, -p0, -p0, 0, 0, 0}, path);
-    const Sym6& end = r.points.back().stress;
-    const double err = std::abs(-end[1] - expected) / expected;
-    worst = std::max(worst, err);
-    EXPECT_LT(err, 1e-3) << "psi " << psi << ": sigma_yy " << end[1];
-    // sigma_zz is the intermediate principal stress.
-    EXPECT_LT(end[1], end[2]);
-    EXPECT_LT(end[2], end[0]);
+    worst = std::max(worst, plane_strain_peak_error(*m, p0, expected, 3.0, psi));
   }
   std::printf("[ figures  ] Drucker-Prager plane-strain peak, worst relative error to Mohr-Coulomb: %.2e\n", worst);
 }
@@ -665,16 +671,7 @@ TEST(MohrCoulombPerzyna, PlaneStrainPeakIsTheMohrCoulombOne) {
   double worst = 0.0;
   for (double psi : {0.0, 30.0}) {
     auto m = material_from_toml(mohr_coulomb(phi, psi, 20.0));
-    LoadPath path = LoadPath::plane_strain_compression(-0.01);
-    path.duration = 1.5;
-    path.dt = 1e-3;
-    const PathResult r = integrate_path(*m, {-p0, -p0, -p0, 0, 0, 0}, path);
-    const Sym6& end = r.points.back().stress;
-    const double err = std::abs(-end[1] - expected) / expected;
-    worst = std::max(worst, err);
-    EXPECT_LT(err, 1e-3) << "psi " << psi << ": sigma_yy " << end[1];
-    EXPECT_LT(end[1], end[2]);
-    EXPECT_LT(end[2], end[0]);
+    worst = std::max(worst, plane_strain_peak_error(*m, p0, expected, 1.5, psi));
   }
   std::printf("[ figures  ] Mohr-Coulomb plane-strain peak, worst relative error: %.2e\n", worst);
 }
