@@ -2,7 +2,7 @@
 # Install the Debian 12 packages rktsph needs to build, test and plot (run as root).
 set -eu
 PACKAGES="build-essential cmake git pkg-config libeigen3-dev libtomlplusplus-dev libcli11-dev \
-libfmt-dev nlohmann-json3-dev libhdf5-dev libgtest-dev libgmock-dev libbenchmark-dev \
+libfmt-dev nlohmann-json3-dev libmuparser-dev libhdf5-dev libgtest-dev libgmock-dev libbenchmark-dev \
 python3 python3-matplotlib python3-meshio python3-numpy"
 missing=""
 for p in $PACKAGES; do

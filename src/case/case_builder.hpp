@@ -116,9 +116,12 @@ class CaseBuilder {
   /// 2D: an initial rigid motion v = velocity + omega e_z x (x - centre).
   CaseBuilder& initial_velocity(const Vec<Dim>& velocity, double omega = 0.0,
                                 const Vec<Dim>& centre = Vec<Dim>::Zero()) {
-    c_.initial_velocity = velocity;
-    c_.initial_angular_velocity = omega;
-    c_.initial_rotation_centre = centre;
+    InitialVelocitySpec<Dim> spec;
+    spec.where = "CaseBuilder::initial_velocity";
+    spec.velocity = velocity;
+    spec.angular_velocity = omega;
+    spec.centre = centre;
+    c_.initial_velocities = {spec};
     return *this;
   }
   CaseBuilder& initial_stress(const Sym6& uniform) {

@@ -197,23 +197,16 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     }
     is->finish();
   }
-  if (auto iv = root.optional_table("initial_velocity")) {
-    if (iv->has("velocity"))
-      c.initial_velocity = read_vector<Dim>(*iv, "velocity");
-    else
-      iv->number("velocity", 0.0);
-    if (iv->has("angular_velocity")) {
-      if (Dim != 2) iv->fail("angular_velocity", "a rigid rotation is available in 2D only");
-      c.initial_angular_velocity = iv->number("angular_velocity");
-      if (iv->has("centre"))
-        c.initial_rotation_centre = read_vector<Dim>(*iv, "centre");
-      else
-        iv->number("centre", 0.0);
+  // A single [initial_velocity] table (the whole body) or [[initial_velocity]] entries.
+  if (root.has("initial_velocity")) {
+    if (root.raw()["initial_velocity"].is_array_of_tables()) {
+      for (const io::Section& iv : root.tables("initial_velocity"))
+        c.initial_velocities.push_back(read_initial_velocity<Dim>(iv, c));
     } else {
-      iv->number("angular_velocity", 0.0);
-      iv->number("centre", 0.0);
+      c.initial_velocities.push_back(read_initial_velocity<Dim>(root.table("initial_velocity"), c));
     }
-    iv->finish();
+  } else {
+    root.optional_table("initial_velocity");  // mark as read
   }
 
   // ---- solver

@@ -5,33 +5,44 @@
 #include <filesystem>
 #include <limits>
 
+#include "case/initial_velocity.hpp"
 #include "case/particle_file_reader.hpp"
 #include "core/error.hpp"
 
 namespace rktsph::case_reading {
+
+namespace {
+
+/// The keys x, y (each [min, max], m) of a node selector into `region`; false when none is given.
+template <int Dim>
+bool read_axis_ranges(const io::Section& s, Region<Dim>& region) {
+  bool any_axis = false;
+  for (int d = 0; d < Dim; ++d) {
+    const std::string axis(kAxisNames[static_cast<std::size_t>(d)]);
+    if (!s.has(axis)) {
+      s.number(axis, 0.0);
+      continue;
+    }
+    const auto range = s.numbers(axis);
+    if (range.size() != 2 || range[1] < range[0]) {
+      s.fail(axis, "must be a range [min, max] in m with min <= max (use [a, a] for a plane)");
+    }
+    region.lo[static_cast<std::size_t>(d)] = range[0];
+    region.hi[static_cast<std::size_t>(d)] = range[1];
+    region.bounded[static_cast<std::size_t>(d)] = true;
+    any_axis = true;
+  }
+  return any_axis;
+}
+
+}  // namespace
 
 template <int Dim>
 BoundarySpec<Dim> read_boundary(const io::Section& b, const CaseSetup<Dim>& c) {
   BoundarySpec<Dim> spec;
   spec.name = b.string("name", b.path());
   spec.where = b.where();
-  bool any_axis = false;
-  for (int d = 0; d < Dim; ++d) {
-    const std::string axis(kAxisNames[static_cast<std::size_t>(d)]);
-    if (!b.has(axis)) {
-      b.number(axis, 0.0);
-      continue;
-    }
-    const auto range = b.numbers(axis);
-    if (range.size() != 2 || range[1] < range[0]) {
-      b.fail(axis, "must be a range [min, max] in m with min <= max (use [a, a] for a plane)");
-    }
-    spec.region.lo[static_cast<std::size_t>(d)] = range[0];
-    spec.region.hi[static_cast<std::size_t>(d)] = range[1];
-    spec.region.bounded[static_cast<std::size_t>(d)] = true;
-    any_axis = true;
-  }
-  if (!any_axis) {
+  if (!read_axis_ranges(b, spec.region)) {
     b.fail("", fmt::format("selects no region: give at least one of {} as [min, max]", Dim == 1 ? "x" : "x, y"));
   }
   if (auto v = b.optional_table("velocity")) {
@@ -77,6 +88,47 @@ BoundarySpec<Dim> read_boundary(const io::Section& b, const CaseSetup<Dim>& c) {
   }
   spec.function = function_index(c, b, "function");
   b.finish();
+  return spec;
+}
+
+template <int Dim>
+InitialVelocitySpec<Dim> read_initial_velocity(const io::Section& s, const CaseSetup<Dim>& c) {
+  InitialVelocitySpec<Dim> spec;
+  spec.where = s.where();
+  read_axis_ranges(s, spec.region);  // none: every node
+  if (s.has("material")) {
+    spec.material = material_index(c.material_names, s, "material");
+  } else {
+    s.string("material", "");
+  }
+  if (s.has("velocity"))
+    spec.velocity = read_vector<Dim>(s, "velocity");
+  else
+    s.number("velocity", 0.0);
+  if (s.has("angular_velocity")) {
+    if (Dim != 2) s.fail("angular_velocity", "a rigid rotation is available in 2D only");
+    spec.angular_velocity = s.number("angular_velocity");
+    if (s.has("centre"))
+      spec.centre = read_vector<Dim>(s, "centre");
+    else
+      s.number("centre", 0.0);
+  } else {
+    s.number("angular_velocity", 0.0);
+    s.number("centre", 0.0);
+  }
+  if (auto f = s.optional_table("function")) {
+    for (const std::string& axis : f->keys()) {
+      const int a = axis_of(axis);
+      if (a < 0 || a >= Dim) {
+        f->fail(axis, fmt::format("unknown velocity component (a {}D case has: {})", Dim, Dim == 1 ? "x" : "x, y"));
+      }
+      const std::string expression = f->string(axis);
+      check_position_expression(expression, Dim, f->where(axis));
+      spec.expression[static_cast<std::size_t>(a)] = expression;
+    }
+    f->finish();
+  }
+  s.finish();
   return spec;
 }
 
@@ -168,6 +220,8 @@ typename CaseSetup<Dim>::ImportedParticles read_imported_particles(const CaseDoc
 
 template BoundarySpec<1> read_boundary<1>(const io::Section&, const CaseSetup<1>&);
 template BoundarySpec<2> read_boundary<2>(const io::Section&, const CaseSetup<2>&);
+template InitialVelocitySpec<1> read_initial_velocity<1>(const io::Section&, const CaseSetup<1>&);
+template InitialVelocitySpec<2> read_initial_velocity<2>(const io::Section&, const CaseSetup<2>&);
 template ProbeSpec read_probe<1>(const io::Section&, const CaseSetup<1>&);
 template ProbeSpec read_probe<2>(const io::Section&, const CaseSetup<2>&);
 template CaseSetup<1>::ImportedParticles read_imported_particles<1>(const CaseDocument&,

@@ -64,6 +64,10 @@ inline int material_index(const std::vector<std::string>& names, const io::Secti
 template <int Dim>
 BoundarySpec<Dim> read_boundary(const io::Section& b, const CaseSetup<Dim>& c);
 
+/// One [initial_velocity] table or [[initial_velocity]] entry.
+template <int Dim>
+InitialVelocitySpec<Dim> read_initial_velocity(const io::Section& s, const CaseSetup<Dim>& c);
+
 /// One [[probe]] entry.
 template <int Dim>
 ProbeSpec read_probe(const io::Section& p, const CaseSetup<Dim>& c);

@@ -48,6 +48,23 @@ struct Region {
   }
 };
 
+/// An initial velocity entry (docs/case-format.md "[initial_velocity]"): a uniform velocity, a
+/// rigid rotation and a function of position, on the nodes it selects by material and box; a
+/// later entry replaces an earlier one on the nodes both select.
+template <int Dim>
+struct InitialVelocitySpec {
+  std::string where;        // "case.toml, line 12, key 'initial_velocity'" for error messages
+  Region<Dim> region;       // no axis bounded: every node
+  int material = -1;        // index into CaseSetup::materials, -1: any
+  Vec<Dim> velocity = Vec<Dim>::Zero();  // m/s
+  /// 2D: v += omega e_z x (x - centre) (rad/s, counter-clockwise positive).
+  double angular_velocity = 0.0;
+  Vec<Dim> centre = Vec<Dim>::Zero();
+  /// A function of the initial position per component (muparser syntax in x, y; m/s), added to
+  /// the rest; empty: none.
+  std::array<std::string, Dim> expression{};
+};
+
 template <int Dim>
 struct BoundarySpec {
   std::string name;
@@ -160,11 +177,9 @@ struct CaseSetup {
   std::optional<double> k0;             // geostatic lateral coefficient; default nu/(1-nu)
   std::optional<double> surface_level;  // geostatic ground surface (vertical axis = last axis)
   Sym6 uniform_stress{};                // uniform initial stress (xx, yy, zz, xy, yz, xz), Pa
-  Vec<Dim> initial_velocity = Vec<Dim>::Zero();
-  /// 2D: a rigid rotation added to it, v += omega e_z x (x - centre) (rad/s, counter-clockwise
-  /// positive), so that a spinning or swinging body needs no boundary entry per node.
-  double initial_angular_velocity = 0.0;
-  Vec<Dim> initial_rotation_centre = Vec<Dim>::Zero();
+  /// Initial velocity entries, so that impacts and spinning bodies need no boundary entry per
+  /// node; none: at rest.
+  std::vector<InitialVelocitySpec<Dim>> initial_velocities;
 
   // time
   double end_time = 0.0;

@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include "case/initial_velocity.hpp"
 #include "case/size_limits.hpp"
 #include "core/error.hpp"
 #include "schemes/registry.hpp"
@@ -216,17 +217,12 @@ void StaggeredModel<Dim>::set_initial_state() {
   auto v = nodes.view(fields.velocity);
   auto s = nodes.view(fields.stress);
   auto k = nodes.view(fields.history);
+  const InitialVelocityField<Dim> initial_velocity(setup.initial_velocities);
   for (Index i = 0; i < nn; ++i) {
     const auto iu = static_cast<std::size_t>(i);
-    for (int d = 0; d < Dim; ++d) v(i, d) = setup.initial_velocity[d];
-    if constexpr (Dim == 2) {
-      if (setup.initial_angular_velocity != 0.0) {
-        const Vec<Dim> r = nodes.position[iu] - setup.initial_rotation_centre;
-        v(i, 0) -= setup.initial_angular_velocity * r[1];
-        v(i, 1) += setup.initial_angular_velocity * r[0];
-      }
-    }
     const int m = nodes.material[iu];
+    const Vec<Dim> v0 = initial_velocity.at(nodes.position[iu], m);
+    for (int d = 0; d < Dim; ++d) v(i, d) = v0[d];
     if (setup.initial_stress == InitialStressKind::geostatic) {
       // method-notes §4.2 option A: sigma_v = -rho g (H - z), lateral = K0 sigma_v.
       const double nu = materials[m].elastic().nu;
