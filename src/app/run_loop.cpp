@@ -366,7 +366,7 @@ int run_loop(const LoopInput& in) {
           kVersion, opt.case_file, Dim, solver.nodes().size(), solver.stress_points().size(), dt, solver.cfl(),
           total_steps, threads, threads > 1 ? "s" : "", exec::adaptive_teams() ? " (adaptive)" : "", wait_policy);
     }
-    if (pressure != nullptr && pressure->impermeable_stress_face_nodes() > 0 &&
+    if (pressure != nullptr && pressure->impermeable_stress_face_nodes() > 0 && !pressure->implicit_faces() &&
         pressure->undrained_courant() > PorePressureStage<Dim>::kUndrainedCourantLimit) {
       std::cerr << fmt::format(
           "warning: {} boundary nodes are on impermeable faces that carry a total stress (or are free), and the "

@@ -101,6 +101,10 @@ struct FluidSpec {
   /// points' pressure-free half-step velocity, with the stabilisation S_w (dt/2)/rho (source-free
   /// when the stress points are at rest; method-notes §2.4).
   bool divergence_from_stress_points = false;
+  /// solver.pressure_faces = "implicit": the effective-stress condition at impermeable faces that
+  /// carry a total stress is taken at t^{n+1} in the pressure step (method-notes eq. (2.4.16));
+  /// false ("explicit"): with p^n, stable only below C c_u/c_d = 3.5 (eq. (4.3.2)).
+  bool implicit_faces = true;
   /// solver.pressure_filter: coefficient of the linear-exact pressure filter, in units of the
   /// fractional-step stabilisation S_w dt/rho (0 = none; method-notes §2.4).
   double filter = 0.5;

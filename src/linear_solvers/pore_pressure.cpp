@@ -38,6 +38,11 @@ struct PorePressureSolver::Impl {
   // row-major matrix (kParallelUnknowns).
   Eigen::ConjugateGradient<Sparse, Eigen::Lower | Eigen::Upper, Eigen::DiagonalPreconditioner<double>> cg_diag_parallel;
   bool parallel = false;
+  // The implicit face condition (face_coupling): K + A, not symmetric.
+  Sparse K_coupled;
+  Sparse A;  // free rows of A, all columns (A p^n on the right-hand side)
+  Eigen::BiCGSTAB<Sparse, Eigen::DiagonalPreconditioner<double>> bicgstab;
+  bool coupled = false;
   Eigen::VectorXd rhs, x, p_all, p_d;
   Eigen::VectorXd previous;  // p^n on the free unknowns at the last solve (for the starting guess)
   bool has_previous = false;
@@ -47,9 +52,11 @@ PorePressureSolver::~PorePressureSolver() = default;
 
 const PorePressureSolver::Sparse& PorePressureSolver::matrix() const { return impl_->K; }
 
+bool PorePressureSolver::coupled() const { return impl_->coupled; }
+
 PorePressureSolver::PorePressureSolver(const Sparse& full, const Sparse& symmetric, const std::vector<bool>& dirichlet,
                                        const Settings& settings, const Sparse* filter_symmetric,
-                                       const Sparse* filter_explicit)
+                                       const Sparse* filter_explicit, const Sparse* face_coupling)
     : impl_(std::make_unique<Impl>()), settings_(settings) {
   const bool filtered = settings.filter > 0.0;
   if (filtered && (filter_symmetric == nullptr || filter_explicit == nullptr)) {
@@ -117,7 +124,32 @@ PorePressureSolver::PorePressureSolver(const Sparse& full, const Sparse& symmetr
   impl_->x.resize(nf);
   impl_->p_all.resize(static_cast<Eigen::Index>(n));
   impl_->p_d.resize(nd);
+  if (face_coupling != nullptr && face_coupling->nonZeros() > 0) {
+    std::vector<Triplet> kc, a;
+    for (Eigen::Index r = 0; r < nf; ++r) {
+      const auto i = static_cast<Eigen::Index>(free_[static_cast<std::size_t>(r)]);
+      for (Sparse::InnerIterator it(*face_coupling, i); it; ++it) {
+        const auto j = static_cast<std::size_t>(it.col());
+        if (dirichlet[j]) throw SolverError("pore pressure: a face coupling at a drained node");
+        kc.emplace_back(r, index_[j], it.value());
+        a.emplace_back(r, it.col(), it.value());
+      }
+    }
+    Sparse coupling(nf, nf);
+    coupling.setFromTriplets(kc.begin(), kc.end());
+    impl_->K_coupled = impl_->K + coupling;
+    impl_->A.resize(nf, static_cast<Eigen::Index>(n));
+    impl_->A.setFromTriplets(a.begin(), a.end());
+    impl_->coupled = true;
+  }
   if (nf == 0) return;
+  if (impl_->coupled) {
+    impl_->bicgstab.setTolerance(settings.tolerance);
+    impl_->bicgstab.setMaxIterations(settings.max_iterations);
+    impl_->bicgstab.compute(impl_->K_coupled);
+    if (impl_->bicgstab.info() != Eigen::Success) throw SolverError("pore pressure: the Jacobi preconditioner failed");
+    return;
+  }
   // K and its preconditioner are factorised once (method-notes §2.4 "Solver").
   auto prepare = [&](auto& cg, const char* what) {
     cg.setTolerance(settings.tolerance);
@@ -178,6 +210,7 @@ void PorePressureSolver::solve(std::span<const double> source, std::span<const d
   if (settings_.deferred_correction) m.rhs.noalias() += settings_.k_eff * (m.D * m.p_all);
   if (settings_.incremental > 0.0) m.rhs.noalias() -= settings_.incremental * (m.S_f * m.p_all);
   if (settings_.filter > 0.0) m.rhs.noalias() -= m.F * m.p_all;
+  if (m.coupled) m.rhs.noalias() += m.A * m.p_all;
   int iterations = 0;
   double error = 0.0;
   bool ok = false;
@@ -187,7 +220,9 @@ void PorePressureSolver::solve(std::span<const double> source, std::span<const d
     error = cg.error();
     ok = cg.info() == Eigen::Success;
   };
-  if (settings_.preconditioner == PressurePreconditioner::incomplete_cholesky) {
+  if (m.coupled) {
+    run(m.bicgstab);
+  } else if (settings_.preconditioner == PressurePreconditioner::incomplete_cholesky) {
     run(m.cg_ic);
   } else if (m.parallel) {
     run(m.cg_diag_parallel);
@@ -196,9 +231,9 @@ void PorePressureSolver::solve(std::span<const double> source, std::span<const d
   }
   if (!ok || !std::isfinite(error)) {
     throw SolverError(
-        fmt::format("pore pressure: the conjugate gradient did not converge ({} iterations, "
+        fmt::format("pore pressure: the {} did not converge ({} iterations, "
                     "relative residual {:.3g}, tolerance {:.3g})",
-                    iterations, error, settings_.tolerance));
+                    m.coupled ? "BiCGSTAB" : "conjugate gradient", iterations, error, settings_.tolerance));
   }
   for (Eigen::Index r = 0; r < nf; ++r) p[static_cast<std::size_t>(free_[static_cast<std::size_t>(r)])] = m.x[r];
   ++stats_.solves;

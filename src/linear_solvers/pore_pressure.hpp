@@ -58,9 +58,12 @@ class PorePressureSolver {
 
   /// `full` and `symmetric` are L and S (1/m^2); `dirichlet[I]` is true at drained nodes.
   /// With `settings.filter` > 0, `filter_symmetric` and `filter_explicit` are S_f and (T G)_f.
+  /// With `face_coupling` (A of schemes/face_pressure_coupling.hpp, node x node, its columns at
+  /// free nodes), the matrix is K + A and the right-hand side gains A p^n: K + A is not
+  /// symmetric, so the solve is Eigen's BiCGSTAB with the Jacobi preconditioner.
   PorePressureSolver(const Sparse& full, const Sparse& symmetric, const std::vector<bool>& dirichlet,
                      const Settings& settings, const Sparse* filter_symmetric = nullptr,
-                     const Sparse* filter_explicit = nullptr);
+                     const Sparse* filter_explicit = nullptr, const Sparse* face_coupling = nullptr);
   ~PorePressureSolver();
   PorePressureSolver(const PorePressureSolver&) = delete;
   PorePressureSolver& operator=(const PorePressureSolver&) = delete;
@@ -83,6 +86,8 @@ class PorePressureSolver {
   Index unknowns() const { return static_cast<Index>(free_.size()); }
   /// K restricted to the free (non-drained) nodes (tests: symmetry, definiteness).
   const Sparse& matrix() const;
+  /// True when the implicit face coupling is in the matrix (BiCGSTAB instead of CG).
+  bool coupled() const;
 
  private:
   struct Impl;

@@ -87,6 +87,12 @@ PorePressureStage<Dim>::PorePressureStage(StaggeredModel<Dim>& model) : m_(model
     s.incremental = fl.saturation * stabilisation_time_ / rho;
     pressure_gradient_.assign(nn * static_cast<std::size_t>(Dim), 0.0);
   }
+  // The implicit face condition (method-notes eq. (2.4.16)); with the stress points' divergence
+  // the storage equation reads the half-step velocity, which the coupling does not model.
+  if (fl.implicit_faces && !fl.divergence_from_stress_points) {
+    face_coupling_ = build_face_pressure_coupling<Dim>(m_, conditions_.drained, node_operator_, dt, fl.saturation);
+  }
+  const PorePressureSolver::Sparse* coupling = face_coupling_.empty() ? nullptr : &face_coupling_.storage_matrix;
   if (fl.filter > 0.0) {
     // Linear-exact pressure filter (solver.pressure_filter, operators/laplacian.hpp): tau (S_f p -
     // T G p) on the plain node set (no wall mirrors: psi_IJ pairs real nodes), G the corrected
@@ -98,15 +104,16 @@ PorePressureStage<Dim>::PorePressureStage(StaggeredModel<Dim>& model) : m_(model
     const NodeLaplacian<Dim> plain = build_node_laplacian<Dim>(relation, nodes, m_.kernel);
     const PorePressureSolver::Sparse tg = build_filter_gradient_part<Dim>(plain.symmetric, nodes.position, grad);
     solver_ =
-        std::make_unique<PorePressureSolver>(lap.full, lap.symmetric, conditions_.drained, s, &plain.symmetric, &tg);
+        std::make_unique<PorePressureSolver>(lap.full, lap.symmetric, conditions_.drained, s, &plain.symmetric, &tg, coupling);
   } else {
-    solver_ = std::make_unique<PorePressureSolver>(lap.full, lap.symmetric, conditions_.drained, s);
+    solver_ = std::make_unique<PorePressureSolver>(lap.full, lap.symmetric, conditions_.drained, s, nullptr, nullptr,
+                                                   coupling);
   }
 }
 
 template <int Dim>
 std::string PorePressureStage<Dim>::instability_hint() const {
-  if (impermeable_stress_faces_ == 0 || undrained_courant_ <= kUndrainedCourantLimit) return {};
+  if (impermeable_stress_faces_ == 0 || undrained_courant_ <= kUndrainedCourantLimit || implicit_faces()) return {};
   return fmt::format(
       " (V3: impermeable faces carrying a total stress are unstable above C c_u/c_d = {}; "
       "here it is {:.2f}: time.cfl <= {:.3f})",
@@ -246,6 +253,8 @@ void PorePressureStage<Dim>::run(const StepContext& context) {
     const double f = dt / nodes.density[static_cast<std::size_t>(i)];
     for (int d = 0; d < Dim; ++d) v(i, d) -= f * g[d];
   });
+  // The face condition at t^{n+1}: v += B (p^{n+1} - p^n) (method-notes eq. (2.4.16)).
+  if (!face_coupling_.empty()) face_coupling_.add_velocity(v, pw, pw_old.data());
   seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 

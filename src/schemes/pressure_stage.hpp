@@ -9,6 +9,7 @@
 
 #include "bc/pore_pressure_conditions.hpp"
 #include "linear_solvers/pore_pressure.hpp"
+#include "schemes/face_pressure_coupling.hpp"
 #include "schemes/stage.hpp"
 #include "schemes/staggered_model.hpp"
 
@@ -51,6 +52,8 @@ class PorePressureStage final : public Stage {
   /// kUndrainedCourantLimit (docs/VALIDATION.md, Case 16).
   double undrained_courant() const { return undrained_courant_; }
   Index impermeable_stress_face_nodes() const { return impermeable_stress_faces_; }
+  /// Those faces are taken implicitly (solver.pressure_faces = "implicit"): the limit is gone.
+  bool implicit_faces() const { return !face_coupling_.empty(); }
   static constexpr double kUndrainedCourantLimit = 3.5;
   /// The growth guard's hint when the limit above is exceeded (empty otherwise).
   std::string instability_hint() const;
@@ -60,6 +63,7 @@ class PorePressureStage final : public Stage {
   Field<double, 1> pressure_;
   PorePressureConditions conditions_;
   CorrectedOperator<Dim> node_operator_;  // nodes -> nodes: div v*, grad p
+  FacePressureCoupling<Dim> face_coupling_;  // implicit face condition (empty: none or explicit)
   std::unique_ptr<PorePressureSolver> solver_;
   std::vector<double> p_old_, source_;
   std::vector<double> pressure_gradient_;  // incremental projection: grad p^n / rho (Dim per node)

@@ -203,6 +203,19 @@ TEST(Saturated, UndrainedLimitGivesTheUndrainedResponse) {
   EXPECT_NEAR(r.sigma_mid, -5.0e3 * kM / (kM + kQ), 0.1 * 5.0e3 * kM / (kM + kQ));
 }
 
+// With water's bulk modulus (K_f = 2.2 GPa: C c_u/c_d = 7.4 at C = 0.5) the impermeable loaded
+// top was unstable within 8 steps with the explicit face condition; with the implicit one it runs
+// the 3 s (about 600 transits of the undrained wave) to the undrained response.
+TEST(Saturated, StiffWaterUnderAnImpermeableLoadedFaceRunsAtTheDrainedStep) {
+  const UndrainedColumn r = run_undrained_column({"fluid.bulk_modulus=2.2e9"});
+  const double q = 2.2e9 / 0.3, p0 = 5.0e3 * q / (kM + q);
+  EXPECT_NEAR(r.dt, 0.5 * 0.1 / std::sqrt(kM / kRho), 1e-12);
+  EXPECT_NEAR(r.p_mid, p0, 0.001 * p0);
+  EXPECT_NEAR(r.p_top, p0, 0.01 * p0);
+  EXPECT_NEAR(r.settlement, 5.0e3 * 10.0 / (kM + q), 0.05 * 5.0e3 * 10.0 / (kM + q));
+  EXPECT_THROW(run_undrained_column({"fluid.bulk_modulus=2.2e9", "solver.pressure_faces=explicit"}), SolverError);
+}
+
 // The same column with the storage equation driven by the stress points' velocity
 // (solver.pressure_divergence = "stress_points", half the stabilisation): stable at k = 0 with
 // the drained skeleton's time step, and the same undrained response.
@@ -521,12 +534,17 @@ TEST(Saturated, PressureFilterDampsTheCheckerboardThatTheIncrementalProjectionKe
       incremental, filtered, projection);
 }
 
-// The known V3 instability (docs/VALIDATION.md, Case 16): impermeable faces carrying a total
-// stress, undrained Courant number C c_u / c_d above about 3.5. At C = 0.5 the run must stop
-// with a diagnosis while the state is still finite (the energy growth guard), and at C = 0.2
-// it runs.
-TEST(Saturated, AnUnstableRunStopsWithADiagnosisWhileTheStateIsFinite) {
-  auto run = [](double cfl) {
+// A plane-strain sample with K_f = 2.2 GPa, impermeable faces, a lateral TOTAL stress (the
+// configuration of Case 16), its top driven down. Returns the growth guard's message (empty if
+// the run finished), the largest |v| or |sigma|, and the centre's pore pressure at the end.
+struct SampleRun {
+  std::string message;
+  double largest = 0.0;
+  double centre_pressure = 0.0;
+};
+
+SampleRun run_loaded_impermeable_sample(double cfl, const std::string& faces, double end) {
+  {
     test::ThreadCount one(1);
     test::TempDir dir;
     const std::string text = fmt::format(R"(
@@ -548,6 +566,7 @@ bulk_modulus = 2.2e9
 conductivity = 1.0e-9
 [solver]
 version = "v3"
+pressure_faces = "{}"
 [initial_stress]
 type = "uniform"
 xx = -5.0e4
@@ -570,15 +589,15 @@ name = "right"
 x = [0.4, 0.4]
 stress = {{ xx = -5.0e4, xy = 0.0 }}
 [time]
-end = 0.02
+end = {}
 cfl = {}
 )",
-                                         cfl);
+                                         faces, end, cfl);
     auto setup = test::case_from_string<2>(dir, text);
     Simulation<2> solver(setup);
     std::string message;
     try {
-      while (solver.time() < 0.02 - 1e-12) solver.step();
+      while (solver.time() < end - 1e-12) solver.step();
     } catch (const SolverError& e) {
       message = e.what();
     }
@@ -587,15 +606,43 @@ cfl = {}
       vmax = std::max(vmax, std::abs(v));
     for (double s : values_of(solver.model().nodes.view(solver.model().fields.stress)))
       vmax = std::max(vmax, std::abs(s));
-    return std::make_pair(message, vmax);
-  };
-  const auto [unstable, v_unstable] = run(0.5);
-  EXPECT_NE(unstable.find("kinetic energy"), std::string::npos) << unstable;
-  EXPECT_NE(unstable.find("unstable"), std::string::npos) << unstable;
-  EXPECT_NE(unstable.find("C c_u/c_d"), std::string::npos) << unstable;  // names the V3 limit and a safe cfl
-  EXPECT_TRUE(std::isfinite(v_unstable));
-  const auto [stable, v_stable] = run(0.2);
-  EXPECT_TRUE(stable.empty()) << stable;
+    std::size_t centre = 0;
+    const auto& nodes = solver.nodes();
+    for (std::size_t i = 0; i < static_cast<std::size_t>(nodes.size()); ++i) {
+      if ((nodes.position[i] - Vec<2>(0.2, 0.2)).norm() < 1e-9) centre = i;
+    }
+    return SampleRun{message, vmax, solver.node_pore_pressure()[centre]};
+  }
+}
+
+// The V3 instability of the explicit face condition (solver.pressure_faces = "explicit",
+// method-notes eq. (4.3.2)): impermeable faces carrying a total stress, undrained Courant number
+// C c_u / c_d above about 3.5. At C = 0.5 the run must stop with a diagnosis while the state
+// is still finite (the energy growth guard), and at C = 0.2 it runs.
+TEST(Saturated, AnUnstableRunStopsWithADiagnosisWhileTheStateIsFinite) {
+  const SampleRun unstable = run_loaded_impermeable_sample(0.5, "explicit", 0.02);
+  const std::string& message = unstable.message;
+  EXPECT_NE(message.find("kinetic energy"), std::string::npos) << message;
+  EXPECT_NE(message.find("unstable"), std::string::npos) << message;
+  EXPECT_NE(message.find("C c_u/c_d"), std::string::npos) << message;  // names the V3 limit and a safe cfl
+  EXPECT_TRUE(std::isfinite(unstable.largest));
+  const SampleRun stable = run_loaded_impermeable_sample(0.2, "explicit", 0.02);
+  EXPECT_TRUE(stable.message.empty()) << stable.message;
+}
+
+// The implicit face condition (the default, method-notes eqs. (2.4.15)-(2.4.17)) removes that
+// limit: the same sample at C = 0.5 (C c_u/c_d = 7.1) runs 0.2 s, about 800 transits of the
+// undrained wave, bounded, and its pore pressure is that of the stable explicit run at C = 0.2.
+TEST(Saturated, ImplicitFacesAreStableAtTheDrainedCourantNumber) {
+  const SampleRun implicit_run = run_loaded_impermeable_sample(0.5, "implicit", 0.2);
+  EXPECT_TRUE(implicit_run.message.empty()) << implicit_run.message;
+  EXPECT_LT(implicit_run.largest, 1.0e6);  // |sigma| stays near the 50 kPa confinement
+  const SampleRun reference = run_loaded_impermeable_sample(0.2, "explicit", 0.2);
+  ASSERT_TRUE(reference.message.empty()) << reference.message;
+  EXPECT_GT(reference.centre_pressure, 1.0e3);  // the compression did raise p_w
+  EXPECT_NEAR(implicit_run.centre_pressure, reference.centre_pressure, 0.02 * reference.centre_pressure);
+  std::printf("centre p_w at 0.2 s: implicit C = 0.5 %.2f Pa, explicit C = 0.2 %.2f Pa\n",
+              implicit_run.centre_pressure, reference.centre_pressure);
 }
 
 }  // namespace
