@@ -47,7 +47,7 @@ int run_lem(const LemOptions& o) {
   j["git_revision"] = kGitRevision;
   j["case_file"] = o.case_file;
   j["title"] = problem.title;
-  j["method"] = "Bishop simplified, circular slip surfaces (method-notes §7)";
+  j["method"] = "Bishop simplified, circular slip surfaces (method-notes §9)";
   j["soil"] = {{"material", problem.material_name},
                {"model", problem.model},
                {"cohesion_Pa", problem.soil.cohesion},

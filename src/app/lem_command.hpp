@@ -1,6 +1,6 @@
 #pragma once
 // `rktsph lem CASE.toml [--out DIR]`: Bishop's simplified method with a search over circular
-// slip surfaces on the case's bodies and soil (lem/bishop.hpp, method-notes §7); writes
+// slip surfaces on the case's bodies and soil (lem/bishop.hpp, method-notes §9); writes
 // DIR/lem.json and, when /usr/bin/python3 has matplotlib, DIR/lem.png (scripts/plot_lem.py).
 #include <string>
 #include <vector>

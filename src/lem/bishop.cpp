@@ -1,4 +1,4 @@
-// Bishop's simplified method of slices and the critical-circle search (method-notes §7).
+// Bishop's simplified method of slices and the critical-circle search (method-notes §9).
 #include "lem/bishop.hpp"
 
 #include <algorithm>
@@ -21,7 +21,7 @@ const char* rejection_name(Rejection r) {
 }
 
 double fellenius_factor(const std::vector<Slice>& slices, const Soil& soil) {
-  // Eq. (7.3): F = sum(c l + W cos(alpha) tan(phi)) / sum(W sin(alpha)).
+  // Eq. (9.3): F = sum(c l + W cos(alpha) tan(phi)) / sum(W sin(alpha)).
   const double tan_phi = std::tan(soil.friction_angle);
   double resisting = 0.0, driving = 0.0;
   for (const Slice& s : slices) {
@@ -40,7 +40,7 @@ std::optional<double> bishop_factor(std::vector<Slice>& slices, const Soil& soil
   double F = fellenius_factor(slices, soil);
   if (!(F > 0.0) || !std::isfinite(F)) F = 1.0;
   for (int it = 1; it <= options.max_iterations; ++it) {
-    // Eq. (7.2) with m_alpha of eq. (7.5) at the previous F; the floor of eq. (7.6) only on the
+    // Eq. (9.2) with m_alpha of eq. (9.5) at the previous F; the floor of eq. (9.6) only on the
     // toe side (alpha < 0), where friction lowers m_alpha.
     double resisting = 0.0;
     std::size_t n_limited = 0;
@@ -111,7 +111,7 @@ CircleResult evaluate_circle(const SoilGeometry& g, const Soil& soil, const Circ
     s.width = b;
     const double dx = s.x - c.x;
     s.base_y = c.y - std::sqrt(std::max(0.0, R * R - dx * dx));
-    s.height = g.soil_above(s.x, s.base_y);  // eq. (7.4)
+    s.height = g.soil_above(s.x, s.base_y);  // eq. (9.4)
     s.weight = soil.unit_weight * b * s.height;
     s.alpha = std::asin(std::clamp(dx / R, -1.0, 1.0));
     moment += s.weight * dx;
@@ -120,7 +120,7 @@ CircleResult evaluate_circle(const SoilGeometry& g, const Soil& soil, const Circ
     out.rejection = Rejection::no_driving;
     return out;
   }
-  // Eq. (7.1): alpha measured so that the weight drives, sum(W sin(alpha)) > 0.
+  // Eq. (9.1): alpha measured so that the weight drives, sum(W sin(alpha)) > 0.
   const double sense = moment > 0.0 ? 1.0 : -1.0;
   out.direction = moment > 0.0 ? -1 : 1;
   for (Slice& s : slices) {

@@ -1,6 +1,6 @@
 #pragma once
 // Bishop's simplified method of slices on circular slip surfaces, and the search for the
-// critical circle (method-notes §7). Dry soil (no pore pressure), no external loads, no
+// critical circle (method-notes §9). Dry soil (no pore pressure), no external loads, no
 // tension crack.
 #include <cstddef>
 #include <optional>
@@ -61,20 +61,20 @@ struct CircleResult {
 
 struct BishopOptions {
   int slices = 50;
-  double m_alpha_floor = 0.2;  // method-notes eq. (7.6)
+  double m_alpha_floor = 0.2;  // method-notes eq. (9.6)
   double tolerance = 1e-7;     // relative change of F that ends the iteration
   int max_iterations = 200;
 };
 
-/// Slices (equal widths between the entry and the exit) and F of one circle (eqs. (7.1)-(7.6)).
+/// Slices (equal widths between the entry and the exit) and F of one circle (eqs. (9.1)-(9.6)).
 CircleResult evaluate_circle(const SoilGeometry& soil_geometry, const Soil& soil, const Circle& circle,
                              const BishopOptions& options, bool keep_slices = false);
 
-/// The F of given slices by Bishop's simplified method, eq. (7.2), by fixed-point iteration from
+/// The F of given slices by Bishop's simplified method, eq. (9.2), by fixed-point iteration from
 /// the ordinary method's value; fills each slice's m_alpha. `iterations` receives the count.
 std::optional<double> bishop_factor(std::vector<Slice>& slices, const Soil& soil, const BishopOptions& options,
                                     int* iterations, std::size_t* limited);
-/// The ordinary method of slices (Fellenius), eq. (7.3).
+/// The ordinary method of slices (Fellenius), eq. (9.3).
 double fellenius_factor(const std::vector<Slice>& slices, const Soil& soil);
 
 struct SearchOptions {

@@ -1,5 +1,5 @@
 // The soil of a limit-equilibrium analysis: membership, vertical sections and circle crossings
-// of a union of polygons with holes (method-notes §7).
+// of a union of polygons with holes (method-notes §9).
 #include "lem/slope_geometry.hpp"
 
 #include <algorithm>

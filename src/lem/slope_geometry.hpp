@@ -1,5 +1,5 @@
 #pragma once
-// The soil of a limit-equilibrium analysis (method-notes §7): a union of bodies, each a closed
+// The soil of a limit-equilibrium analysis (method-notes §9): a union of bodies, each a closed
 // polygon with optional holes, and the rigid regions (boxes) a slip surface may not cross.
 // Everything the slices need is asked of the union by point membership and vertical
 // sections, so overlapping or touching bodies (a union of blocks) need no outline merging.
@@ -51,7 +51,7 @@ class SoilGeometry {
 
   /// Inside the union of the bodies (even-odd rule per body, holes excluded).
   bool contains(Point p) const;
-  /// Length of soil on the vertical line at x above the height y (eq. (7.4)).
+  /// Length of soil on the vertical line at x above the height y (eq. (9.4)).
   double soil_above(double x, double y) const;
   /// The crossings of the circle (centre, radius) with the boundary of the union whose height
   /// is below the centre (its lower half), seams between touching bodies left out, coincident

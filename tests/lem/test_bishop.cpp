@@ -1,4 +1,4 @@
-// Bishop's simplified method and the critical-circle search (lem/bishop.hpp, method-notes §7)
+// Bishop's simplified method and the critical-circle search (lem/bishop.hpp, method-notes §9)
 // against a hand computation, the ordinary method where they must agree (phi = 0), Taylor's
 // (1937, 1948) stability numbers for phi = 0 and the published value of the 2:1 c-phi slope.
 #include <gtest/gtest.h>
@@ -60,8 +60,8 @@ double stability_number(const SoilGeometry& g, const Soil& s, double H) {
 //   13.22975  4.16777   5.83223   315885.36    42.30992
 //   15.93785  2.17966   7.82034   423565.05    30.25732
 //   18.64595  0.92240   9.07760   491661.07    19.54993
-// sum(W sin alpha) = 710205.15 N/m. Ordinary method, eq. (7.3): F = 0.790809; Bishop,
-// eq. (7.2) iterated from it: F = 0.813169 (a desk computation of the same formulas).
+// sum(W sin alpha) = 710205.15 N/m. Ordinary method, eq. (9.3): F = 0.790809; Bishop,
+// eq. (9.2) iterated from it: F = 0.813169 (a desk computation of the same formulas).
 TEST(Bishop, OneCircleAgainstAFourSliceHandComputation) {
   const Soil soil{10.0e3, 20.0 * kPi / 180.0, 20.0e3};
   BishopOptions o;
@@ -231,7 +231,7 @@ TEST(Bishop, InadmissibleCirclesAreRejected) {
   EXPECT_EQ(evaluate_circle(gn, soil, {{11.0, 20.0}, 12.5}, {}).rejection, Rejection::not_two_crossings);
 }
 
-// The m_alpha safeguard, eq. (7.6): a toe slice with alpha = -70 deg and phi = 40 deg has
+// The m_alpha safeguard, eq. (9.6): a toe slice with alpha = -70 deg and phi = 40 deg has
 // m_alpha = 0.342 - 0.789/F, below 0.2 for F < 5.6 (here F = 2.4); it is raised to 0.2 and counted.
 TEST(Bishop, MAlphaFloorOnTheToeSide) {
   const Soil soil{5.0e3, 40.0 * kPi / 180.0, 20.0e3};
@@ -253,7 +253,7 @@ TEST(Bishop, MAlphaFloorOnTheToeSide) {
   EXPECT_TRUE(s[2].m_alpha_limited);
   EXPECT_DOUBLE_EQ(s[2].m_alpha, 0.2);
   EXPECT_LT(std::cos(s[2].alpha) + std::sin(s[2].alpha) * std::tan(soil.friction_angle) / *F, 0.2);
-  // F is the fixed point of eq. (7.2) with the floored m_alpha.
+  // F is the fixed point of eq. (9.2) with the floored m_alpha.
   double resisting = 0.0, driving = 0.0;
   for (const Slice& q : s) {
     const double m = q.m_alpha_limited ? 0.2 : std::cos(q.alpha) + std::sin(q.alpha) * std::tan(soil.friction_angle) / *F;
