@@ -1,6 +1,7 @@
 // `rktsph lem`: the limit-equilibrium reference of a case (docs/output.md, "lem.json").
 #include "app/lem_command.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -39,7 +40,19 @@ int run_lem(const LemOptions& o) {
       o.out_dir.empty() ? (std::filesystem::path("out") / (std::filesystem::path(o.case_file).stem().string() + "-lem")).string()
                         : o.out_dir;
   const auto& g = problem.geometry;
-  const lem::SearchResult r = lem::search_critical_circle(g, problem.soil, o.search);
+  lem::SearchOptions search = o.search;
+  if (!o.centre_box.empty()) {
+    const auto& b = o.centre_box;
+    if (b.size() != 4 || !(b[1] > b[0]) || !(b[3] > b[2]) ||
+        !std::all_of(b.begin(), b.end(), [](double v) { return std::isfinite(v); })) {
+      throw InputError("--centres: give X0 X1 Y0 Y1 in m with X1 > X0 and Y1 > Y0");
+    }
+    search.x_lo = b[0];
+    search.x_hi = b[1];
+    search.y_lo = b[2];
+    search.y_hi = b[3];
+  }
+  const lem::SearchResult r = lem::search_critical_circle(g, problem.soil, search);
   std::filesystem::create_directories(out_dir);
 
   nlohmann::json j;

@@ -14,6 +14,7 @@ struct LemOptions {
   std::string out_dir;  // default out/<case name>-lem
   std::vector<std::string> overrides;
   lem::SearchOptions search;
+  std::vector<double> centre_box;  // --centres X0 X1 Y0 Y1 (m), empty: the default box
   bool plot = true;
   bool quiet = false;
 };

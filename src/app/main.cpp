@@ -143,6 +143,11 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 20));
   lem_cmd->add_option("--radii", lem_opt.search.radii, "Radii scanned per centre before refining (default 30)")
       ->check(CLI::Range(3, 10000));
+  lem_cmd
+      ->add_option("--centres", lem_opt.centre_box,
+                   "First search box of circle centres: X0 X1 Y0 Y1 in m (default: 3H beyond the soil on each "
+                   "side, mid-height to 3H above its top)")
+      ->expected(4);
   lem_cmd->add_flag("!--no-plot", lem_opt.plot, "Skip the matplotlib plot");
   lem_cmd->add_flag("--quiet,-q", lem_opt.quiet, "No summary output");
 

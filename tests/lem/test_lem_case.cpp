@@ -3,7 +3,10 @@
 // as one error with file, line and key (exit status 2).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
 #include <numbers>
 #include <string>
 
@@ -187,6 +190,41 @@ TEST(LemCommand, WritesLemJsonAndExitsTwoOnBadInput) {
   EXPECT_EQ(r.status, 2) << r.out;
   EXPECT_NE(r.out.find("clockwise"), std::string::npos) << r.out;
   EXPECT_EQ(std::count(r.out.begin(), r.out.end(), '\n'), 1) << r.out;
+  // Every face rigid: no admissible circle, exit status 3 with the search box named.
+  const std::string boxed =
+      dir.write("boxed.toml", polygon(kSlope) + kMohrCoulomb + kGravity +
+                                  "[[boundary]]\nx = [-100.0, 100.0]\ny = [-100.0, 100.0]\nvelocity = { x = 0.0 }\n");
+  const auto none = test::run_command(
+      fmt::format("\"{}\" lem \"{}\" --no-plot --grid 5 --levels 1 --out \"{}\" 2>&1", RKTSPH_BINARY, boxed,
+                  dir.file("boxed_out")));
+  EXPECT_EQ(none.status, 3) << none.out;
+  EXPECT_NE(none.out.find("no admissible slip circle"), std::string::npos) << none.out;
+  // A bad --centres box is an input error.
+  const auto box = test::run_command(fmt::format(
+      "\"{}\" lem \"{}/cases/examples/slope_2to1_c10_phi20.toml\" --no-plot --centres 10 0 10 40 --out \"{}\" 2>&1",
+      RKTSPH_BINARY, RKTSPH_SOURCE_DIR, dir.file("box_out")));
+  EXPECT_EQ(box.status, 2) << box.out;
+  EXPECT_NE(box.out.find("--centres"), std::string::npos) << box.out;
+}
+
+// With matplotlib, the command draws lem.png; a given centre box is used and reported.
+TEST(LemCommand, PlotAndAGivenCentreBox) {
+  if (std::system("/usr/bin/python3 -c 'import matplotlib' >/dev/null 2>&1") != 0) {
+    GTEST_SKIP() << "no /usr/bin/python3 with matplotlib";
+  }
+  test::TempDir dir;
+  const std::string out = dir.file("case5");
+  const auto ok = test::run_command(
+      fmt::format("\"{}\" lem \"{}/cases/thesis/05_viscoplastic_cut_2d.toml\" --grid 11 --levels 4 --centres 20 50 "
+                  "10 40 --out \"{}\" 2>&1",
+                  RKTSPH_BINARY, RKTSPH_SOURCE_DIR, out));
+  ASSERT_EQ(ok.status, 0) << ok.out;
+  EXPECT_TRUE(std::filesystem::exists(out + "/lem.png")) << ok.out;
+  const auto j = nlohmann::json::parse(test::read_text(out + "/lem.json"));
+  EXPECT_EQ(j["search"]["first_box"]["x"][0], 20.0);
+  EXPECT_EQ(j["search"]["first_box"]["y"][1], 40.0);
+  const double taylor = 57710.0 / (0.261 * 2000.0 * 9.81 * 10.0);
+  EXPECT_NEAR(j["factor_of_safety"].get<double>(), taylor, 0.01 * taylor);
 }
 
 }  // namespace
