@@ -154,8 +154,12 @@ std::vector<Crossing> SoilGeometry::lower_crossings(Point centre, double radius)
           const Point p{a.x + t * dx, a.y + t * dy};
           if (p.y >= centre.y - tol_) continue;
           // A seam between touching bodies has soil on both sides; keep only the union's boundary.
+          // The sides are probed from a point of this edge next to p but off its ends (at a vertex
+          // the normal offset could land outside a sharp wedge on both sides).
+          const double ts = std::clamp(t, std::min(0.5, 4.0 * probe / len), std::max(0.5, 1.0 - 4.0 * probe / len));
+          const Point q{a.x + ts * dx, a.y + ts * dy};
           const Point nrm{dy / len * probe, -dx / len * probe};
-          const bool in1 = contains({p.x + nrm.x, p.y + nrm.y}), in2 = contains({p.x - nrm.x, p.y - nrm.y});
+          const bool in1 = contains({q.x + nrm.x, q.y + nrm.y}), in2 = contains({q.x - nrm.x, q.y - nrm.y});
           if (in1 == in2) continue;
           out.push_back({p, on_rigid(p)});
         }

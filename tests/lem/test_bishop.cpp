@@ -231,6 +231,29 @@ TEST(Bishop, InadmissibleCirclesAreRejected) {
   EXPECT_EQ(evaluate_circle(gn, soil, {{11.0, 20.0}, 12.5}, {}).rejection, Rejection::not_two_crossings);
 }
 
+// A circle through a vertex: centre (5, 25), R = sqrt(450) meets the 2:1 face y = x/2 at x = 8
+// and at the crest corner (20, 10) (1.25 x^2 - 35 x + 200 = 0), and the crest nowhere else; at
+// the toe wedge (0, 0) the vertex is found by either edge too.
+TEST(SoilGeometry, CrossingsAtVerticesAreFoundOnce) {
+  Body b;
+  b.outer = {{0.0, 0.0}, {40.0, 0.0}, {40.0, 10.0}, {20.0, 10.0}};
+  const SoilGeometry g({b}, {base_at(0.0), wall_at(40.0)});
+  const auto x = g.lower_crossings({5.0, 25.0}, std::sqrt(450.0));
+  ASSERT_EQ(x.size(), 2u);
+  EXPECT_NEAR(x[0].p.x, 8.0, 1e-9);
+  EXPECT_NEAR(x[0].p.y, 4.0, 1e-9);
+  EXPECT_NEAR(x[1].p.x, 20.0, 1e-9);
+  EXPECT_NEAR(x[1].p.y, 10.0, 1e-9);
+  const CircleResult r = evaluate_circle(g, {10.0e3, 0.3, 20.0e3}, {{5.0, 25.0}, std::sqrt(450.0)}, {});
+  EXPECT_TRUE(r.valid()) << rejection_name(r.rejection);
+  // Centre (-2, 20) through the toe (0, 0): the toe is found, and it is on the rigid base.
+  const auto t = g.lower_crossings({-2.0, 20.0}, std::sqrt(404.0));
+  ASSERT_FALSE(t.empty());
+  EXPECT_NEAR(t[0].p.x, 0.0, 1e-9);
+  EXPECT_NEAR(t[0].p.y, 0.0, 1e-9);
+  EXPECT_TRUE(t[0].rigid);
+}
+
 // The m_alpha safeguard, eq. (9.6): a toe slice with alpha = -70 deg and phi = 40 deg has
 // m_alpha = 0.342 - 0.789/F, below 0.2 for F < 5.6 (here F = 2.4); it is raised to 0.2 and counted.
 TEST(Bishop, MAlphaFloorOnTheToeSide) {
