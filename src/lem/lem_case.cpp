@@ -237,6 +237,12 @@ LemProblem read_lem_problem(const CaseDocument& doc) {
       if (b.has("stress")) out.notes.push_back(fmt::format("{}: boundary stresses are not included", b.where()));
       continue;
     }
+    if (!b.has("x") && !b.has("y")) {
+      // A selection the analysis cannot see as a box (e.g. by an edge of a polygon) must not
+      // silently make the whole plane rigid.
+      b.fail("", "prescribes a velocity but selects no x/y box; the limit-equilibrium analysis takes the rigid "
+                 "regions from x = [min, max] and y = [min, max] ranges only");
+    }
     RigidRegion r;
     r.name = b.string("name", b.path());
     for (int d = 0; d < 2; ++d) {

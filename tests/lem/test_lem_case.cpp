@@ -123,6 +123,9 @@ TEST(LemCase, BadGeometryIsAnErrorWithFileLineAndKey) {
                 .find("unknown material 'clay'"),
             std::string::npos);
   EXPECT_NE(error_of(polygon(kSlope) + kMohrCoulomb, "body_force").find("gravity"), std::string::npos);
+  EXPECT_NE(error_of(polygon(kSlope) + rest + "[[boundary]]\nedge = 0\nvelocity = { x = 0.0 }\n", "boundary[0]")
+                .find("selects no x/y box"),
+            std::string::npos);
   EXPECT_NE(error_of(polygon(kSlope) + kMohrCoulomb + "\n[body_force]\ngravity = [1.0, -10.0]\n", "gravity")
                 .find("vertical"),
             std::string::npos);
