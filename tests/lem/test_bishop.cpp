@@ -169,6 +169,21 @@ TEST(BishopSearch, TwoToOneSlopeAgainstThePublishedChartValue) {
   EXPECT_EQ(r.critical.limited_slices, 0u);
 }
 
+// The same slope facing the other way (x -> 40 - x): the same F, sliding towards +x.
+TEST(BishopSearch, MirroredSlopeGivesTheSameFactor) {
+  const Soil soil{10.0e3, 20.0 * kPi / 180.0, 20.0e3};
+  Body left, right;
+  left.outer = {{0.0, 0.0}, {40.0, 0.0}, {40.0, 10.0}, {20.0, 10.0}};
+  right.outer = {{0.0, 0.0}, {40.0, 0.0}, {20.0, 10.0}, {0.0, 10.0}};
+  const SearchResult a = search_critical_circle(SoilGeometry({left}, {base_at(0.0), wall_at(40.0)}), soil, {});
+  const SearchResult b = search_critical_circle(SoilGeometry({right}, {base_at(0.0), wall_at(0.0)}), soil, {});
+  ASSERT_TRUE(a.found() && b.found());
+  EXPECT_NEAR(a.critical.factor, b.critical.factor, 1e-6 * a.critical.factor);
+  EXPECT_EQ(a.critical.direction, -1);
+  EXPECT_EQ(b.critical.direction, 1);
+  EXPECT_NEAR(b.critical.exit.x, 40.0 - a.critical.exit.x, 1e-3);
+}
+
 // Thesis case 5 through the block path: N = gamma H / c = 3.40 (c = 57.71 kPa, rho = 2000 kg/m^3,
 // g = 9.81 m/s^2), so Taylor's N_s = 0.261 gives F = c / (0.261 gamma H) = 1.127.
 TEST(BishopSearch, ThesisCase5CutThroughTheBlockGeometry) {
