@@ -13,6 +13,7 @@
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
+#include "app/lem_command.hpp"
 #include "app/material_point.hpp"
 #include "app/run_case.hpp"
 #include "case/material_reader.hpp"
@@ -91,7 +92,8 @@ int main(int argc, char** argv) {
       "Examples:\n"
       "  rktsph run cases/thesis/01_elastic_bar_1d.toml\n"
       "  rktsph run case.toml --out runs/stiff --set material.E=2.5e7 --threads 2\n"
-      "  rktsph material-point cases/material_point/cam_clay_drained_nc.toml\n"};
+      "  rktsph material-point cases/material_point/cam_clay_drained_nc.toml\n"
+      "  rktsph lem cases/examples/slope_2to1_c10_phi20.toml\n"};
   app.set_version_flag("--version", fmt::format("rktsph {} ({})", kVersion, kGitRevision));
   app.require_subcommand(1);
 
@@ -127,6 +129,28 @@ int main(int argc, char** argv) {
 
   auto* mat_cmd = app.add_subcommand("materials", "List the constitutive models");
 
+  LemOptions lem_opt;
+  auto* lem_cmd = app.add_subcommand(
+      "lem", "Limit equilibrium: Bishop's simplified method, search for the critical circle (lem.json + plot)");
+  lem_cmd->add_option("case", lem_opt.case_file, "Case file (TOML)")->required()->check(CLI::ExistingFile);
+  lem_cmd->add_option("--out,-o", lem_opt.out_dir, "Output folder (default: out/<case name>-lem)");
+  lem_cmd->add_option("--set,-s", lem_opt.overrides, "Override a case key, e.g. --set material.cohesion=12e3");
+  lem_cmd->add_option("--slices", lem_opt.search.bishop.slices, "Slices per circle (default 50)")
+      ->check(CLI::Range(4, 100000));
+  lem_cmd->add_option("--grid", lem_opt.search.grid, "Centres per axis of each search level (default 21)")
+      ->check(CLI::Range(3, 401));
+  lem_cmd->add_option("--levels", lem_opt.search.levels, "Search levels: the first grid and its refinements (default 5)")
+      ->check(CLI::Range(1, 20));
+  lem_cmd->add_option("--radii", lem_opt.search.radii, "Radii scanned per centre before refining (default 30)")
+      ->check(CLI::Range(3, 10000));
+  lem_cmd
+      ->add_option("--centres", lem_opt.centre_box,
+                   "First search box of circle centres: X0 X1 Y0 Y1 in m (default: 3H beyond the soil on each "
+                   "side, mid-height to 3H above its top)")
+      ->expected(4);
+  lem_cmd->add_flag("!--no-plot", lem_opt.plot, "Skip the matplotlib plot");
+  lem_cmd->add_flag("--quiet,-q", lem_opt.quiet, "No summary output");
+
   validation::Options val;
   val.cases_dir = std::string(RKTSPH_SOURCE_DIR) + "/cases/thesis";
   bool val_quick = false;
@@ -157,6 +181,7 @@ int main(int argc, char** argv) {
       return resume_case(resume);
     }
     if (mp_cmd->parsed()) return run_material_point(mp_file, mp_out, mp_overrides);
+    if (lem_cmd->parsed()) return run_lem(lem_opt);
     if (val_cmd->parsed()) {
       resolve_threads(run.threads);
       return validation::run_validation(val);
