@@ -92,7 +92,8 @@ int main(int argc, char** argv) {
       "Examples:\n"
       "  rktsph run cases/thesis/01_elastic_bar_1d.toml\n"
       "  rktsph run case.toml --out runs/stiff --set material.E=2.5e7 --threads 2\n"
-      "  rktsph material-point cases/material_point/cam_clay_drained_nc.toml\n"};
+      "  rktsph material-point cases/material_point/cam_clay_drained_nc.toml\n"
+      "  rktsph fos cases/thesis/05_viscoplastic_cut_2d.toml --tol 0.02\n"};
   app.set_version_flag("--version", fmt::format("rktsph {} ({})", kVersion, kGitRevision));
   app.require_subcommand(1);
 
