@@ -52,6 +52,9 @@ def main():
         peak = max(ke) if max(ke) > 0 else 1.0
         ax_k.semilogy(t, [max(k / peak, 1e-12) for k in ke], style, color=colour, lw=1.0)
     ax_u.axhline(0.05, color="k", lw=0.8, ls="--", label="collapse: u_c = 0.05 L")
+    # Collapsing trials run far past the threshold: keep the region around it readable.
+    low, high = ax_u.get_ylim()
+    ax_u.set_ylim(max(min(low, -0.005), -0.02), min(high, 0.2))
     if t_end > 0:
         ax_u.axvspan(t_end - window, t_end, color="0.9", zorder=0, label="classification window")
         ax_k.axvspan(t_end - window, t_end, color="0.9", zorder=0)
