@@ -328,8 +328,11 @@ int run_fos(const FosOptions& opt) {
       if (tr.exit_code != 0 && tr.exit_code != kExitUnstable) {
         if (failure.empty()) {
           failure_code = tr.exit_code;
-          failure = tr.error.empty() ? fmt::format("trial {} (F = {:.4f}) stopped with exit status {}", tr.index,
-                                                   tr.factor, tr.exit_code)
+          failure = tr.error.empty() ? fmt::format("trial {} (F = {:.4f}) stopped with exit status {}{}", tr.index,
+                                                   tr.factor, tr.exit_code,
+                                                   tr.exit_code > 128 ? fmt::format(" (signal {}: interrupted)",
+                                                                                    tr.exit_code - 128)
+                                                                      : std::string())
                                      : fmt::format("trial {} (F = {:.4f}): {}", tr.index, tr.factor, tr.error);
         }
         tr.outcome = "failed";
