@@ -24,3 +24,13 @@ add_test(NAME fuzz_inputs
          COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/scripts/fuzz_inputs.py --binary $<TARGET_FILE:rktsph>
                  --count 4000 --seed 14 --jobs 2 --timeout 120 --work ${CMAKE_BINARY_DIR}/test-out/fuzz)
 set_tests_properties(fuzz_inputs PROPERTIES LABELS fuzz PROCESSORS 2 TIMEOUT 900)
+
+# `rktsph fos` (docs/fos.md) on Case 5's cut at the quick spacing 0.5 m, tolerance 2 %, two trials
+# at once: gamma H / c_F = 3.4 F must lie in the limit-analysis bracket [3.64, 4.00] of cases.md
+# Case 5. 6 trials in 3 rounds; about 50 s on a 2-core machine (PROCESSORS 2: it uses both).
+add_test(NAME fos_quick
+         COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/scripts/check_fos.py --binary $<TARGET_FILE:rktsph>
+                 --case ${PROJECT_SOURCE_DIR}/cases/thesis/05_viscoplastic_cut_2d.toml
+                 --out ${CMAKE_BINARY_DIR}/test-out/fos_quick --scale 3.4 --low 3.64 --high 4.00
+                 -- --set geometry.spacing=0.5 --tol 0.02 --jobs 2 --threads 2 --quiet)
+set_tests_properties(fos_quick PROPERTIES LABELS validation PROCESSORS 2 TIMEOUT 600)

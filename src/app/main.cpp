@@ -14,6 +14,7 @@
 #include <CLI/CLI.hpp>
 
 #include "app/lem_command.hpp"
+#include "app/fos.hpp"
 #include "app/material_point.hpp"
 #include "app/run_case.hpp"
 #include "case/material_reader.hpp"
@@ -93,7 +94,8 @@ int main(int argc, char** argv) {
       "  rktsph run cases/thesis/01_elastic_bar_1d.toml\n"
       "  rktsph run case.toml --out runs/stiff --set material.E=2.5e7 --threads 2\n"
       "  rktsph material-point cases/material_point/cam_clay_drained_nc.toml\n"
-      "  rktsph lem cases/examples/slope_2to1_c10_phi20.toml\n"};
+      "  rktsph lem cases/examples/slope_2to1_c10_phi20.toml\n"
+      "  rktsph fos cases/thesis/05_viscoplastic_cut_2d.toml --tol 0.02\n"};
   app.set_version_flag("--version", fmt::format("rktsph {} ({})", kVersion, kGitRevision));
   app.require_subcommand(1);
 
@@ -165,6 +167,26 @@ int main(int argc, char** argv) {
   val_cmd->add_option("--threads,-j", run.threads, "Number of threads (default and bound as for run)")
       ->check(CLI::NonNegativeNumber);
 
+  FosOptions fos;
+  auto* fos_cmd = app.add_subcommand(
+      "fos", "Factor of safety by strength reduction: trials at c/F, tan(phi)/F, bisected on F (fos.json + plot)");
+  fos_cmd->add_option("case", fos.case_file, "Case file (TOML; its [fos] table: docs/case-format.md)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  fos_cmd->add_option("--out,-o", fos.out_dir, "Output folder (default: out/<case name>_fos)");
+  fos_cmd->add_option("--set,-s", fos.overrides, "Override a case key for every trial (repeatable)");
+  fos_cmd->add_option("--solver", fos.solver, "Solver of the trials (default: the case's solver.version, v1 unless set)")
+      ->check(CLI::IsMember({"v1", "v2", "v3"}));
+  fos_cmd->add_option("--tol", fos.tolerance, "Relative tolerance on F (default: fos.tolerance, 0.01)")
+      ->check(CLI::Range(1e-6, 0.999));
+  fos_cmd->add_option("--max-trials", fos.max_trials, "Trials the search may use (default: fos.max_trials, 12)")
+      ->check(CLI::Range(2, 200));
+  fos_cmd->add_option("--jobs", fos.jobs, "Trials run at once (default: one per thread)")->check(CLI::Range(1, 64));
+  fos_cmd->add_option("--threads,-j", fos.threads, "Threads in all, shared by the trials at once (default as for run)")
+      ->check(CLI::NonNegativeNumber);
+  fos_cmd->add_flag("--quiet,-q", fos.quiet, "No progress lines");
+  fos_cmd->add_flag("!--no-plot", fos.plot, "Skip the u_c(t) plot");
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -179,6 +201,12 @@ int main(int argc, char** argv) {
     if (resume_cmd->parsed()) {
       resume.threads = resolve_threads(resume.threads);
       return resume_case(resume);
+    }
+    if (fos_cmd->parsed()) {
+      fos.threads = resolve_threads(fos.threads);
+      // The trials run side by side, each on a fixed share of the threads: no adaptive teams.
+      exec::adaptive_teams() = false;
+      return run_fos(fos);
     }
     if (mp_cmd->parsed()) return run_material_point(mp_file, mp_out, mp_overrides);
     if (lem_cmd->parsed()) return run_lem(lem_opt);

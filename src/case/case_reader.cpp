@@ -31,6 +31,7 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
   c.file = doc.file;
   io::Section root(doc.table, "", doc.file_label);
   c.title = root.string("title", "");
+  (void)root.optional_table("fos");  // read by `rktsph fos` (app/fos_setup.cpp); a run ignores it
 
   // ---- time functions (read first: other tables refer to them by name)
   if (auto fs = root.optional_table("functions")) {

@@ -6,6 +6,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <mutex>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -16,6 +17,13 @@
 namespace rktsph::io {
 
 namespace {
+
+// The serial HDF5 library is not thread-safe, and `rktsph fos` runs trials side by side on
+// threads (an interrupted search checkpoints them all at once): one HDF5 call sequence at a time.
+std::mutex& hdf5_mutex() {
+  static std::mutex m;
+  return m;
+}
 
 constexpr const char* kFormatName = "rktsph checkpoint";
 
@@ -77,6 +85,7 @@ std::vector<T> read_dataset(hid_t file, const std::string& key, const std::strin
 }  // namespace
 
 void write_checkpoint(const std::string& path, const StateArchive& state) {
+  const std::lock_guard<std::mutex> lock(hdf5_mutex());
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // errors are reported by return codes, below
   StateArchive archive = state;
   archive.put_text("meta/format", kFormatName);
@@ -118,6 +127,7 @@ void write_checkpoint(const std::string& path, const StateArchive& state) {
 }
 
 StateArchive read_checkpoint(const std::string& path) {
+  const std::lock_guard<std::mutex> lock(hdf5_mutex());
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
   if (::access(path.c_str(), R_OK) != 0) {
     throw InputError(system_error_text("read the checkpoint", path, errno));

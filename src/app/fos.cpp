@@ -1,0 +1,415 @@
+// `rktsph fos CASE`: trials of the case at reduced strength, run in parallel when threads allow,
+// classified by the rule of docs/cases.md §1.3, searched by app/fos_search.cpp.
+#include "app/fos.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <limits>
+#include <map>
+#include <sstream>
+#include <thread>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <nlohmann/json.hpp>
+
+#include "app/fos_search.hpp"
+#include "app/fos_setup.hpp"
+#include "app/run_case.hpp"
+#include "core/error.hpp"
+#include "io/output_files.hpp"
+#include "validation/cut_common.hpp"
+#include "validation/validation.hpp"
+
+namespace rktsph {
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+namespace {
+
+struct Trial {
+  int index = 0;  // 1-based, in the order the trials were started
+  double factor = 0.0;
+  fs::path folder;
+  std::vector<std::string> overrides;
+  int exit_code = -1;
+  std::string error;
+  double seconds = 0.0;
+  std::vector<double> t, u, ke;  // the histories: time, monitored displacement, kinetic energy
+  validation::Classification classification;
+  std::string outcome;  // stable, collapse, undecided, or unstable (the solver stopped)
+  bool stable = false;
+  bool used = false;  // on the sequential search's path (else speculative)
+};
+
+// The columns `names` of a CSV file with a header row.
+std::vector<std::vector<double>> read_columns(const fs::path& file, const std::vector<std::string>& names) {
+  std::ifstream in(file);
+  if (!in) throw IoError(fmt::format("{}: cannot read the trial's table", file.string()));
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> header;
+  {
+    std::stringstream s(line);
+    std::string cell;
+    while (std::getline(s, cell, ',')) header.push_back(cell);
+  }
+  std::vector<std::size_t> cols;
+  for (const std::string& n : names) {
+    const auto it = std::find(header.begin(), header.end(), n);
+    if (it == header.end()) throw IoError(fmt::format("{}: no column '{}'", file.string(), n));
+    cols.push_back(static_cast<std::size_t>(it - header.begin()));
+  }
+  std::vector<std::vector<double>> out(names.size());
+  std::vector<double> row;
+  while (std::getline(in, line)) {
+    if (line.empty()) continue;
+    row.clear();
+    std::stringstream s(line);
+    std::string cell;
+    while (std::getline(s, cell, ',')) row.push_back(std::strtod(cell.c_str(), nullptr));
+    if (row.size() < header.size()) break;  // a row cut short by a stopped run
+    for (std::size_t k = 0; k < cols.size(); ++k) out[k].push_back(row[cols[k]]);
+  }
+  return out;
+}
+
+// Linear interpolation of f(t) at tq (clamped); t increasing.
+double interpolate(const std::vector<double>& t, const std::vector<double>& f, double tq) {
+  if (tq <= t.front()) return f.front();
+  if (tq >= t.back()) return f.back();
+  const auto k = static_cast<std::size_t>(std::upper_bound(t.begin(), t.end(), tq) - t.begin());
+  const double w = (tq - t[k - 1]) / (t[k] - t[k - 1]);
+  return (1.0 - w) * f[k - 1] + w * f[k];
+}
+
+// The trial's histories from its probes.csv and energy.csv, and its classification.
+void classify(Trial& tr, const fos::Monitor& m) {
+  const std::string prefix = std::string(fos::kMonitorProbe) + ".";
+  std::vector<std::string> names = {"t", prefix + "ux"};
+  if (m.direction.size() > 1) names.push_back(prefix + "uy");
+  const auto probes = read_columns(tr.folder / "probes.csv", names);
+  const auto energy = read_columns(tr.folder / "energy.csv", {"t", "kinetic"});
+  tr.t = probes[0];
+  tr.u.assign(tr.t.size(), 0.0);
+  for (std::size_t d = 0; d < m.direction.size(); ++d) {
+    for (std::size_t k = 0; k < tr.t.size(); ++k) tr.u[k] += m.direction[d] * probes[d + 1][k];
+  }
+  tr.ke.clear();
+  for (double t : tr.t) tr.ke.push_back(energy[0].empty() ? 0.0 : interpolate(energy[0], energy[1], t));
+  if (!tr.t.empty()) tr.classification = validation::classify_cut(tr.t, tr.u, tr.ke, m.length, m.window);
+  if (tr.exit_code == kExitUnstable) {
+    tr.outcome = "unstable";
+    tr.stable = false;
+  } else {
+    tr.outcome = validation::outcome_name(tr.classification.outcome);
+    tr.stable = tr.classification.outcome == validation::CutOutcome::stable;
+  }
+}
+
+void write_history(const fs::path& file, const Trial& tr) {
+  std::string text = "t,u_c,kinetic\n";
+  for (std::size_t k = 0; k < tr.t.size(); ++k) {
+    text += fmt::format("{:.10g},{:.10g},{:.10g}\n", tr.t[k], tr.u[k], tr.ke[k]);
+  }
+  io::write_file_atomically(file.string(), text, false);
+}
+
+// Make the search's folder: new, empty, or the folder of an earlier search (whose trials go).
+void prepare_folder(const fs::path& out) {
+  std::error_code ec;
+  if (fs::exists(out, ec) && !fs::is_directory(out, ec)) {
+    throw InputError(fmt::format("--out '{}': exists and is not a folder", out.string()));
+  }
+  if (fs::is_directory(out, ec) && !fs::is_empty(out, ec)) {
+    if (!fs::exists(out / "fos.json")) {
+      throw InputError(fmt::format("--out '{}': the folder holds files that are not the output of rktsph fos; "
+                                   "choose an empty or new folder",
+                                   out.string()));
+    }
+    for (const auto& e : fs::directory_iterator(out)) {
+      const std::string name = e.path().filename().string();
+      if (name.rfind("trial_", 0) == 0 || name == "fos.json" || name == "fos_uc.png") fs::remove_all(e.path());
+    }
+  }
+  fs::create_directories(out, ec);
+  if (ec) throw InputError(io::system_error_text("create the output folder", out.string(), ec.value()));
+}
+
+nlohmann::json trial_json(const Trial& tr, const fs::path& out, const fos::StrengthReduction& strength) {
+  const auto& c = tr.classification;
+  double u_max = 0.0;
+  for (double u : tr.u) u_max = std::max(u_max, u);
+  nlohmann::json reduced = nlohmann::json::object();
+  for (const auto& [key, value] : strength.values(tr.factor)) reduced[key] = value;
+  nlohmann::json j = {
+      {"index", tr.index},
+      {"factor", tr.factor},
+      {"outcome", tr.outcome},
+      {"stable", tr.stable},
+      {"used", tr.used},
+      {"folder", fs::relative(tr.folder, out).string()},
+      {"history", fs::relative(tr.folder, out).string() + ".csv"},
+      {"exit_code", tr.exit_code},
+      {"seconds", tr.seconds},
+      {"reduced", reduced},
+      {"u_c",
+       {{"end", c.uc_end},
+        {"max", u_max},
+        {"change_last_window", c.uc_change},
+        {"accelerating", c.accelerating},
+        {"samples", tr.t.size()},
+        {"t_end", tr.t.empty() ? 0.0 : tr.t.back()}}},
+      {"kinetic_ratio_last_window", c.ke_ratio},
+  };
+  if (!tr.error.empty()) j["message"] = tr.error;
+  return j;
+}
+
+std::string bracket_text(const fos::SearchStatus& s) {
+  if (!std::isfinite(s.hi)) return s.lo > 0.0 ? fmt::format("[{:.4f}, -)", s.lo) : std::string("[-, -)");
+  if (s.lo <= 0.0) return fmt::format("[-, {:.4f}]", s.hi);
+  return fmt::format("[{:.4f}, {:.4f}] ({:.2f} % wide)", s.lo, s.hi, 100.0 * (s.hi - s.lo) / s.lo);
+}
+
+}  // namespace
+
+int run_fos(const FosOptions& opt) {
+  const auto t_start = Clock::now();
+  std::vector<std::string> case_overrides = opt.overrides;
+  if (!opt.solver.empty()) case_overrides.push_back("solver.version=" + nlohmann::json(opt.solver).dump());
+  // Everything is checked before a folder is touched: the case, its strengths, the [fos] table
+  // and the monitored node.
+  const CaseDocument doc = load_case_document(opt.case_file, case_overrides);
+  const fos::StrengthReduction strength = fos::read_strength(doc);
+  fos::FosTable table = fos::read_fos_table(doc);
+  if (opt.tolerance > 0.0) table.search.tolerance = opt.tolerance;
+  if (opt.max_trials > 0) table.search.max_trials = opt.max_trials;
+  const fos::SearchSettings& settings = table.search;
+  const fos::Monitor monitor = fos::resolve_monitor(doc, table);
+  const std::string solver_version = [&] {
+    const auto v = doc.table["solver"]["version"].value<std::string>();
+    return v ? *v : std::string("v1");
+  }();
+
+  const fs::path out = opt.out_dir.empty() ? fs::path("out") / (fs::path(opt.case_file).stem().string() + "_fos")
+                                           : fs::path(opt.out_dir);
+  prepare_folder(out);
+  std::vector<std::string> base = case_overrides;
+  base.push_back("output.checkpoint_interval=0");  // the trials are not resumed
+  base.push_back(fos::monitor_probe_override(doc, monitor));
+
+  const int threads = std::max(1, opt.threads);
+  const int jobs = std::clamp(opt.jobs > 0 ? opt.jobs : threads, 1, 64);
+  const int threads_per_trial = std::max(1, threads / jobs);
+  if (!opt.quiet) {
+    std::cerr << fmt::format(
+        "rktsph fos: {} ({}), monitor at [{}] along [{}] ({}), length {} m, window {} s; tolerance {} on F, at "
+        "most {} trials, {} at once ({} thread{} each)\n",
+        opt.case_file, solver_version, fmt::join(monitor.position, ", "), fmt::join(monitor.direction, ", "),
+        monitor.source, monitor.length, monitor.window, settings.tolerance, settings.max_trials, jobs,
+        threads_per_trial, threads_per_trial > 1 ? "s" : "");
+  }
+
+  std::vector<Trial> trials;
+  std::map<double, bool> known;
+  std::vector<fos::Step> path;
+  fos::SearchStatus status;
+  std::string failure;  // a trial that could not be run at all
+  int failure_code = 0;
+  bool non_monotone = false;
+
+  auto write_json = [&](const std::string& state, const std::string& message) {
+    nlohmann::json j;
+    j["case"] = opt.case_file;
+    j["overrides"] = opt.overrides;
+    j["solver"] = solver_version;
+    j["status"] = state;
+    j["message"] = message;
+    const double f = status.factor();
+    j["factor_of_safety"] = std::isfinite(f) ? nlohmann::json(f) : nlohmann::json(nullptr);
+    j["bracket"] = {status.lo > 0.0 ? nlohmann::json(status.lo) : nlohmann::json(nullptr),
+                    std::isfinite(status.hi) ? nlohmann::json(status.hi) : nlohmann::json(nullptr)};
+    j["tolerance"] = settings.tolerance;
+    j["max_trials"] = settings.max_trials;
+    j["growth"] = settings.growth;
+    j["trials_used"] = path.size();
+    j["trials_run"] = trials.size();
+    j["jobs"] = jobs;
+    j["threads_per_trial"] = threads_per_trial;
+    j["non_monotone"] = non_monotone;
+    j["monitor"] = {{"position", monitor.position}, {"direction", monitor.direction}, {"length", monitor.length},
+                    {"window", monitor.window},     {"source", monitor.source}};
+    j["classification"] =
+        "docs/cases.md §1.3 on u_c = u . direction at the monitored node, with H = length: stable if over the last "
+        "window u_c changes by less than 1e-3 H and the kinetic energy stays below 1e-2 of its peak; collapse if u_c "
+        "> 0.05 H or u_c still accelerates; otherwise undecided. Undecided and unstable trials count as not stable.";
+    nlohmann::json mats = nlohmann::json::array();
+    for (const auto& m : strength.materials) {
+      nlohmann::json e = {{"table", m.table}, {"model", m.model}};
+      for (const auto& [key, value] : m.divided) e["divided_by_F"][key] = value;
+      if (m.friction_angle) e["friction_angle"] = *m.friction_angle;
+      if (m.dilatancy) e["dilatancy"] = *m.dilatancy;
+      mats.push_back(e);
+    }
+    j["strength"] = mats;
+    j["unreduced_materials"] = strength.unreduced;
+    j["trials"] = nlohmann::json::array();
+    for (const Trial& tr : trials) j["trials"].push_back(trial_json(tr, out, strength));
+    j["wall_seconds"] = std::chrono::duration<double>(Clock::now() - t_start).count();
+    io::write_file_atomically((out / "fos.json").string(), j.dump(2) + "\n");
+  };
+
+  // A trial that could not be run at all (bad reduced input, a write error, a signal) ends the search.
+  struct TrialFailure {};
+  auto mark_used = [&] {
+    for (Trial& tr : trials) {
+      tr.used = std::any_of(path.begin(), path.end(), [&](const fos::Step& s) { return s.factor == tr.factor; });
+    }
+  };
+  auto evaluate = [&](const std::vector<double>& batch) {
+    mark_used();
+    status = fos::status_after(settings, path);
+    if (!trials.empty()) write_json("running", "");
+    const std::size_t first = trials.size();
+    for (double f : batch) {
+      Trial tr;
+      tr.index = static_cast<int>(trials.size()) + 1;
+      tr.factor = f;
+      tr.folder = out / fmt::format("trial_{:02d}", tr.index);
+      tr.overrides = base;
+      for (const std::string& o : strength.overrides(f)) tr.overrides.push_back(o);
+      trials.push_back(std::move(tr));
+    }
+    if (!opt.quiet) {
+      std::vector<std::string> fs_text;
+      for (double f : batch) fs_text.push_back(fmt::format("{:.4f}", f));
+      std::cerr << fmt::format("fos: bracket {}, {} of {} trials used, {} run; running F = {}{}\n",
+                               bracket_text(status), path.size(), settings.max_trials, first, fmt::join(fs_text, ", "),
+                               batch.size() > 1 ? fmt::format(" ({} at once)", batch.size()) : std::string());
+    }
+    auto run_one = [&](Trial& tr) {
+      const auto t0 = Clock::now();
+      RunOptions ro;
+      ro.case_file = opt.case_file;
+      ro.out_dir = tr.folder.string();
+      ro.overrides = tr.overrides;
+      ro.threads = threads_per_trial;
+      ro.quiet = true;
+      try {
+        tr.exit_code = run_case(ro);
+      } catch (const InputError& e) {
+        tr.exit_code = kExitInput;
+        tr.error = e.what();
+      } catch (const IoError& e) {
+        tr.exit_code = kExitIo;
+        tr.error = e.what();
+      } catch (const std::exception& e) {
+        tr.exit_code = 1;
+        tr.error = e.what();
+      }
+      tr.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    };
+    if (batch.size() == 1) {
+      run_one(trials[first]);
+    } else {
+      std::vector<std::thread> workers;
+      for (std::size_t k = first; k < trials.size(); ++k) workers.emplace_back(run_one, std::ref(trials[k]));
+      for (auto& w : workers) w.join();
+    }
+    std::vector<bool> stable;
+    for (std::size_t k = first; k < trials.size(); ++k) {
+      Trial& tr = trials[k];
+      if (tr.exit_code != 0 && tr.exit_code != kExitUnstable) {
+        if (failure.empty()) {
+          failure_code = tr.exit_code;
+          failure = tr.error.empty() ? fmt::format("trial {} (F = {:.4f}) stopped with exit status {}{}", tr.index,
+                                                   tr.factor, tr.exit_code,
+                                                   tr.exit_code > 128 ? fmt::format(" (signal {}: interrupted)",
+                                                                                    tr.exit_code - 128)
+                                                                      : std::string())
+                                     : fmt::format("trial {} (F = {:.4f}): {}", tr.index, tr.factor, tr.error);
+        }
+        tr.outcome = "failed";
+        continue;
+      }
+      classify(tr, monitor);
+      write_history(tr.folder.string() + ".csv", tr);
+      stable.push_back(tr.stable);
+      if (!opt.quiet) {
+        std::cerr << fmt::format("fos: trial {} F = {:.4f}: {} (u_c = {:.4g} m = {:.3g} L, {:.1f} s)\n", tr.index,
+                                 tr.factor, tr.outcome, tr.classification.uc_end,
+                                 tr.classification.uc_end / monitor.length, tr.seconds);
+      }
+    }
+    if (!failure.empty()) throw TrialFailure{};
+    return stable;
+  };
+  try {
+    status = fos::run_search(settings, jobs, evaluate, path, known);
+  } catch (const TrialFailure&) {
+    status = fos::status_after(settings, path);
+  }
+  mark_used();
+  for (const auto& [fa, sa] : known) {
+    for (const auto& [fb, sb] : known) non_monotone = non_monotone || (sa && !sb && fa > fb);
+  }
+
+  if (!failure.empty()) {
+    const int code = failure_code == kExitInput || failure_code == kExitIo || failure_code > 128 ? failure_code : 1;
+    const std::string message = fmt::format("rktsph fos: {}; the trials so far are kept in {}", failure, out.string());
+    write_json("failed", message);
+    std::cerr << "error: " << message << "\n";
+    return code;
+  }
+  if (non_monotone) {
+    std::cerr << "warning: rktsph fos: a trial stood at a larger F than one that did not (the classification is "
+                 "not monotone in F; see fos.json)\n";
+  }
+  std::string message;
+  int code = 0;
+  const Trial* first_trial = trials.empty() ? nullptr : &trials.front();
+  switch (status.state) {
+    case fos::SearchState::converged:
+      message = fmt::format("F = {:.4f}, bracket [{:.4f}, {:.4f}] (tolerance {} relative), {} trials used, {} run",
+                            status.factor(), status.lo, status.hi, settings.tolerance, path.size(), trials.size());
+      break;
+    case fos::SearchState::unreduced_fails:
+      message = fmt::format(
+          "rktsph fos: the unreduced case (F = {}) does not stand: trial 1 is {} (u_c = {:.4g} m = {:.3g} L at the "
+          "end); strength reduction looks for F >= 1 only; the trial is kept in {}",
+          settings.start, first_trial->outcome, first_trial->classification.uc_end,
+          first_trial->classification.uc_end / monitor.length, first_trial->folder.string());
+      code = kExitNoFactor;
+      break;
+    default:
+      message = fmt::format(
+          "rktsph fos: the bracket {} did not close to the tolerance {} within {} trials{}; raise --max-trials{}; the "
+          "trials are kept in {}",
+          bracket_text(status), settings.tolerance, settings.max_trials,
+          std::isfinite(status.hi) ? "" : " (every trial stood)",
+          std::isfinite(status.hi) ? " or --tol" : " or fos.growth", out.string());
+      code = kExitNoFactor;
+      break;
+  }
+  write_json(fos::state_name(status.state), code == 0 ? "" : message);
+  if (opt.plot) {
+    std::string note;
+    if (!validation::run_plot_script("plot_fos.py", out.string(), note)) std::cerr << "warning: " << note << "\n";
+  }
+  if (code == 0) {
+    std::cerr << fmt::format("rktsph fos: {}; {:.1f} s; fos.json in {}\n", message,
+                             std::chrono::duration<double>(Clock::now() - t_start).count(), out.string());
+    std::cout << fmt::format("{:.6g}\n", status.factor());
+  } else {
+    std::cerr << "error: " << message << "\n";
+  }
+  return code;
+}
+
+}  // namespace rktsph

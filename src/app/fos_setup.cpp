@@ -1,0 +1,278 @@
+#include "app/fos_setup.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include "core/error.hpp"
+#include "io/section.hpp"
+#include "schemes/simulation.hpp"
+
+namespace rktsph::fos {
+
+double reduced_friction_angle(double phi_degrees, double factor) {
+  constexpr double kDeg = std::numbers::pi / 180.0;
+  return std::atan(std::tan(phi_degrees * kDeg) / factor) / kDeg;
+}
+
+std::vector<std::pair<std::string, double>> StrengthReduction::values(double factor) const {
+  std::vector<std::pair<std::string, double>> out;
+  for (const MaterialStrength& m : materials) {
+    // method-notes eq. (10.1): every strength in stress units over F, tan(phi) over F, and the
+    // dilatancy kept unless it would exceed the reduced friction angle.
+    for (const auto& [key, value] : m.divided) out.emplace_back(m.table + "." + key, value / factor);
+    if (m.friction_angle) {
+      const double phi = reduced_friction_angle(*m.friction_angle, factor);
+      out.emplace_back(m.table + ".friction_angle", phi);
+      if (m.dilatancy) out.emplace_back(m.table + ".dilatancy", std::min(*m.dilatancy, phi));
+    }
+  }
+  return out;
+}
+
+std::vector<std::string> StrengthReduction::overrides(double factor) const {
+  std::vector<std::string> out;
+  // The shortest text that reads back as the same double (an integer-looking one is a TOML
+  // integer, which the reader takes as a number too).
+  for (const auto& [key, value] : values(factor)) out.push_back(fmt::format("{}={}", key, value));
+  return out;
+}
+
+namespace {
+
+std::optional<double> number_of(const toml::table& t, const char* key) {
+  const toml::node* n = t.get(key);
+  if (n == nullptr) return std::nullopt;
+  if (const auto v = n->value<double>()) return *v;
+  return std::nullopt;
+}
+
+void add_material(const io::Section& m, StrengthReduction& out) {
+  const std::string model = m.string("model");
+  const toml::table& t = m.raw();
+  MaterialStrength s;
+  s.table = m.path();
+  s.model = model;
+  auto divide = [&](const char* key) {
+    if (const auto v = number_of(t, key)) s.divided.emplace_back(key, *v);
+  };
+  if (model == "elastic") {
+    out.unreduced.push_back(m.path());
+    return;
+  }
+  if (model == "perzyna_von_mises") {
+    divide("cohesion");
+    divide("yield_stress");
+    divide("hardening_modulus");
+    divide("residual_yield_stress");  // its default, 0.1 Y0, follows Y0 by itself
+  } else if (model == "perzyna_drucker_prager" || model == "perzyna_mohr_coulomb") {
+    divide("cohesion");
+    divide("hardening_modulus");
+    divide("residual_cohesion");  // default 0.1 c0: follows c0
+    s.friction_angle = number_of(t, "friction_angle");
+    s.dilatancy = number_of(t, "dilatancy");
+  } else {
+    m.fail("model", fmt::format("rktsph fos: no strength reduction is defined for the model '{}' (its strength "
+                                "comes from the preconsolidation pressure and M, not from a cohesion or a "
+                                "friction angle); strength reduction needs perzyna_von_mises, "
+                                "perzyna_drucker_prager or perzyna_mohr_coulomb",
+                                model));
+  }
+  out.materials.push_back(std::move(s));
+}
+
+}  // namespace
+
+StrengthReduction read_strength(const CaseDocument& doc) {
+  StrengthReduction out;
+  const io::Section root(doc.table, "", doc.file_label);
+  if (root.has("material")) {
+    add_material(root.table("material"), out);
+  } else {
+    const io::Section ms = root.table("materials");
+    for (const std::string& name : ms.keys()) {
+      if (name.find('.') != std::string::npos) {
+        ms.fail(name, "rktsph fos: a material name with a dot cannot be overridden (--set splits keys at dots)");
+      }
+      add_material(ms.table(name), out);
+    }
+  }
+  if (out.materials.empty()) {
+    const std::string table = out.unreduced.empty() ? "material" : out.unreduced.front();
+    throw InputError(fmt::format("{}: rktsph fos: no material has a strength to reduce (every material is "
+                                 "elastic); strength reduction needs a viscoplastic material with a cohesion",
+                                 io::Section(doc.table, "", doc.file_label).where(table)));
+  }
+  return out;
+}
+
+FosTable read_fos_table(const CaseDocument& doc) {
+  FosTable f;
+  const io::Section root(doc.table, "", doc.file_label);
+  f.where = root.where("fos");
+  const auto s = root.optional_table("fos");
+  if (!s) return f;
+  if (s->has("monitor")) {
+    const toml::node* n = s->raw().get("monitor");
+    if (n->is_string()) {
+      f.monitor_probe = s->string("monitor");
+    } else {
+      f.monitor_point = s->numbers("monitor");
+    }
+  }
+  if (s->has("direction")) {
+    std::vector<double> d = s->numbers("direction");
+    double norm = 0.0;
+    for (double v : d) norm += v * v;
+    norm = std::sqrt(norm);
+    s->require(norm > 0.0, "direction", "the direction of the monitored displacement must not be zero");
+    for (double& v : d) v /= norm;
+    f.direction = d;
+  }
+  if (s->has("length")) f.length = s->positive("length");
+  f.window = s->positive("window", 1.0);
+  f.search.tolerance = s->positive("tolerance", f.search.tolerance);
+  s->require(f.search.tolerance < 1.0, "tolerance",
+             fmt::format("the relative tolerance on F must be below 1, got {}", f.search.tolerance));
+  const auto trials = s->integer("max_trials", f.search.max_trials);
+  s->require(trials >= 2 && trials <= 200, "max_trials", fmt::format("must lie in [2, 200], got {}", trials));
+  f.search.max_trials = static_cast<int>(trials);
+  f.search.growth = s->number("growth", f.search.growth);
+  s->require(f.search.growth > 1.0 && f.search.growth <= 10.0, "growth",
+             fmt::format("the expansion factor must lie in (1, 10], got {}", f.search.growth));
+  s->finish();
+  return f;
+}
+
+namespace {
+
+template <int Dim>
+Monitor resolve(const CaseDocument& doc, const FosTable& f) {
+  const CaseSetup<Dim> setup = read_case<Dim>(doc);
+  const Simulation<Dim> solver(setup);
+  const auto& x = solver.nodes().position;
+  const io::Section root(doc.table, "", doc.file_label);
+  const auto fos_table = root.optional_table("fos");
+  auto fail = [&](const char* key, const std::string& message) {
+    if (fos_table) fos_table->fail(key, message);
+    throw InputError(fmt::format("{}: {}", root.where(), message));
+  };
+  Monitor m;
+  m.window = f.window;
+  if (!(f.window < setup.end_time)) {
+    fail("window", fmt::format("the classification window ({} s) must be shorter than time.end ({} s)", f.window,
+                               setup.end_time));
+  }
+  Vec<Dim> target = Vec<Dim>::Zero();
+  if (f.monitor_probe) {
+    const auto p = std::find_if(setup.probes.begin(), setup.probes.end(),
+                                [&](const ProbeSpec& q) { return q.name == *f.monitor_probe; });
+    if (p == setup.probes.end()) {
+      std::vector<std::string> names;
+      for (const ProbeSpec& q : setup.probes) names.push_back(q.name);
+      fail("monitor", fmt::format("no probe named '{}' in the case (its probes: {})", *f.monitor_probe,
+                                  names.empty() ? std::string("none") : fmt::format("{}", fmt::join(names, ", "))));
+    }
+    for (int d = 0; d < Dim; ++d) target[d] = p->position[static_cast<std::size_t>(d)];
+    m.source = fmt::format("probe '{}'", *f.monitor_probe);
+  } else if (f.monitor_point) {
+    if (static_cast<int>(f.monitor_point->size()) != Dim) {
+      fail("monitor", fmt::format("a point of {} coordinates in a {}D case", f.monitor_point->size(), Dim));
+    }
+    for (int d = 0; d < Dim; ++d) target[d] = (*f.monitor_point)[static_cast<std::size_t>(d)];
+    m.source = "point";
+  } else {
+    // The default: the crest of a face that looks towards +x, the node of the top row (largest
+    // last coordinate) with the largest x.
+    const double tol = 1e-6 * setup.dx;
+    double top = -std::numeric_limits<double>::infinity();
+    for (const auto& p : x) top = std::max(top, p[Dim - 1]);
+    double best = -std::numeric_limits<double>::infinity();
+    for (const auto& p : x) {
+      if (p[Dim - 1] >= top - tol && p[0] > best) {
+        best = p[0];
+        target = p;
+      }
+    }
+    m.source = "default: the crest (top row, largest x)";
+  }
+  Index nearest = 0;
+  double dist = std::numeric_limits<double>::infinity();
+  for (Index i = 0; i < solver.nodes().size(); ++i) {
+    const double d = (x[static_cast<std::size_t>(i)] - target).norm();
+    if (d < dist) {
+      dist = d;
+      nearest = i;
+    }
+  }
+  // As for a probe (app/run_loop.cpp): farther than half a cell diagonal is off the body.
+  if (dist > 0.5 * std::sqrt(static_cast<double>(Dim)) * setup.dx + 1e-9) {
+    std::vector<double> t(target.data(), target.data() + Dim);
+    fail("monitor", fmt::format("the monitored point [{}] is not on the body (the nearest node is {:.4g} m away)",
+                                fmt::join(t, ", "), dist));
+  }
+  const auto& p = x[static_cast<std::size_t>(nearest)];
+  m.position.assign(p.data(), p.data() + Dim);
+  if (f.direction) {
+    if (static_cast<int>(f.direction->size()) != Dim) {
+      fail("direction", fmt::format("a direction of {} components in a {}D case", f.direction->size(), Dim));
+    }
+    m.direction = *f.direction;
+  } else {
+    m.direction.assign(static_cast<std::size_t>(Dim), 0.0);
+    m.direction[0] = 1.0;
+  }
+  if (f.length) {
+    m.length = *f.length;
+  } else {
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const auto& q : x) {
+      lo = std::min(lo, q[Dim - 1]);
+      hi = std::max(hi, q[Dim - 1]);
+    }
+    m.length = hi - lo;
+    if (!(m.length > 0.0)) fail("length", "the body has no height: give fos.length (m)");
+  }
+  return m;
+}
+
+}  // namespace
+
+Monitor resolve_monitor(const CaseDocument& doc, const FosTable& table) {
+  if (case_dimension(doc) == 1) return resolve<1>(doc, table);
+  return resolve<2>(doc, table);
+}
+
+std::string monitor_probe_override(const CaseDocument& doc, const Monitor& monitor) {
+  toml::array probes;
+  if (const toml::array* existing = doc.table["probe"].as_array()) {
+    for (const toml::node& p : *existing) {
+      if (const toml::table* t = p.as_table()) {
+        if (t->get("name") != nullptr && t->get("name")->value<std::string>() == kMonitorProbe) {
+          throw InputError(fmt::format("{}: the probe name '{}' is reserved for rktsph fos",
+                                       io::Section(*t, "probe", doc.file_label).where("name"), kMonitorProbe));
+        }
+      }
+      probes.push_back(p);
+    }
+  }
+  toml::array position, fields;
+  for (double v : monitor.position) position.push_back(v);
+  fields.push_back("ux");
+  if (monitor.position.size() > 1) fields.push_back("uy");
+  toml::table probe;
+  probe.insert("name", kMonitorProbe);
+  probe.insert("position", std::move(position));
+  probe.insert("fields", std::move(fields));
+  probes.push_back(std::move(probe));
+  std::ostringstream text;
+  text << probes;
+  return "probe=" + text.str();
+}
+
+}  // namespace rktsph::fos

@@ -1,0 +1,296 @@
+// `rktsph fos` end to end (app/fos.cpp) on a tiny coarse cut: a 10 m x 5 m block at dx = 0.5 m,
+// von Mises, N = gamma H / c = 3.4, whose factor must bracket the limit-analysis N_c (~3.78)
+// within what so coarse a lattice resolves; and every error path (no strength to reduce, a
+// monitor that is missing, an unreduced run that does not stand, a bracket that does not close)
+// stops with its message or exit status and keeps the trials it ran.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "../support/test_util.hpp"
+#include "app/fos.hpp"
+#include "app/fos_setup.hpp"
+#include "core/error.hpp"
+
+namespace rktsph {
+namespace {
+
+namespace fs = std::filesystem;
+
+// gamma H / c = 2000 * 9.81 * 5 / 28853 = 3.40. The gravity ramp of 1 s spans about 5 shear
+// periods of the block; damping until the kinetic energy is 1e-4 of its peak (at the latest
+// 3 s), then 2 s undamped: the last second is the classification window.
+const char* kCut = R"(
+title = "tiny cut for rktsph fos"
+[geometry]
+dimension = 2
+spacing = 0.5
+[[geometry.block]]
+min = [0.0, 0.0]
+max = [10.0, 5.0]
+[material]
+model = "perzyna_von_mises"
+E = 5.0e7
+nu = 0.3
+density = 2000.0
+cohesion = 28853.0
+fluidity = 10.0
+[functions.gravity_ramp]
+type = "ramp"
+duration = 1.0
+[body_force]
+gravity = [0.0, -9.81]
+function = "gravity_ramp"
+[damping]
+coefficient = 5.0
+until_kinetic_ratio = 1.0e-4
+kinetic_ratio_from = 1.0
+kinetic_ratio_hold = 0.3
+until = 3.0
+[[boundary]]
+name = "base"
+y = [0.0, 0.0]
+velocity = { x = 0.0, y = 0.0 }
+[[boundary]]
+name = "left"
+x = [0.0, 0.0]
+velocity = { x = 0.0 }
+[time]
+end = 5.0
+cfl = 0.9
+[output]
+interval = 0.0
+elements = false
+[[probe]]
+name = "crest"
+position = [10.0, 5.0]
+fields = ["ux"]
+)";
+
+nlohmann::json read_json(const fs::path& file) {
+  std::ifstream in(file);
+  return nlohmann::json::parse(in);
+}
+
+FosOptions options(const std::string& file, const fs::path& out) {
+  FosOptions o;
+  o.case_file = file;
+  o.out_dir = out.string();
+  o.tolerance = 0.05;
+  o.jobs = 2;
+  o.threads = 2;
+  o.quiet = true;
+  o.plot = false;
+  return o;
+}
+
+TEST(FosRun, TinyCutBracketsTheLimitAnalysisValue) {
+  test::TempDir dir;
+  const std::string file = dir.write("cut.toml", kCut);
+  const fs::path out = dir.path() / "fos";
+  ASSERT_EQ(run_fos(options(file, out)), 0);
+  const nlohmann::json j = read_json(out / "fos.json");
+  EXPECT_EQ(j["status"], "converged");
+  const double f = j["factor_of_safety"], lo = j["bracket"][0], hi = j["bracket"][1];
+  EXPECT_LE(hi - lo, 0.05 * lo);
+  EXPECT_DOUBLE_EQ(f, 0.5 * (lo + hi));
+  // N_c = 3.4 F: inside Heyman's lower bound 2.83 and the planar-wedge upper bound 4.00 (the
+  // lattice is 10 cells tall; docs/fos.md gives the converged figures).
+  EXPECT_GT(3.4 * lo, 2.83);
+  EXPECT_LT(3.4 * hi, 4.00);
+  // Every trial kept, with its folder, history and classification; those on the search's path
+  // agree with the bracket.
+  ASSERT_GE(j["trials"].size(), j["trials_used"].get<std::size_t>());
+  EXPECT_EQ(j["trials"][0]["factor"], 1.0);
+  EXPECT_EQ(j["trials"][0]["outcome"], "stable");
+  for (const auto& t : j["trials"]) {
+    EXPECT_TRUE(fs::exists(out / t["folder"].get<std::string>() / "summary.json"));
+    EXPECT_TRUE(fs::exists(out / t["history"].get<std::string>()));
+    if (!t["used"]) continue;
+    const double tf = t["factor"];
+    EXPECT_EQ(t["stable"].get<bool>(), tf <= lo) << tf;
+  }
+  // The reduced cohesion of a trial is c / F.
+  const auto& last = j["trials"].back();
+  EXPECT_NEAR(last["reduced"]["material.cohesion"].get<double>(), 28853.0 / last["factor"].get<double>(), 1e-9);
+}
+
+TEST(FosRun, NoStrengthToReduce) {
+  test::TempDir dir;
+  std::string elastic = kCut;
+  elastic.replace(elastic.find("model = \"perzyna_von_mises\""), 27, "model = \"elastic\"");
+  elastic.replace(elastic.find("cohesion = 28853.0\nfluidity = 10.0\n"), 35, "");
+  const std::string file = dir.write("elastic.toml", elastic);
+  try {
+    run_fos(options(file, dir.path() / "fos"));
+    FAIL() << "an elastic case was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("no material has a strength to reduce"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("elastic.toml"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(dir.path() / "fos")) << "nothing is written before the input is checked";
+}
+
+TEST(FosRun, CamClayHasNoReductionRule) {
+  test::TempDir dir;
+  const std::string file = dir.write("cc.toml", R"(
+[geometry]
+dimension = 2
+spacing = 1.0
+[[geometry.block]]
+min = [0.0, 0.0]
+max = [2.0, 2.0]
+[material]
+model = "perzyna_cam_clay"
+E = 1.0e7
+nu = 0.3
+density = 2000.0
+M = 1.0
+lambda = 0.2
+kappa = 0.05
+e0 = 1.0
+p_c0 = 1.0e5
+fluidity = 1.0
+[time]
+end = 1.0
+)");
+  try {
+    (void)fos::read_strength(load_case_document(file, {}));
+    FAIL() << "Cam-Clay was accepted";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("no strength reduction is defined for the model 'perzyna_cam_clay'"), std::string::npos) << m;
+    EXPECT_NE(m.find("line 9"), std::string::npos) << m;
+    EXPECT_NE(m.find("material.model"), std::string::npos) << m;
+  }
+}
+
+TEST(FosRun, StrengthReductionOfEachModel) {
+  test::TempDir dir;
+  const std::string file = dir.write("mats.toml", R"(
+[geometry]
+dimension = 2
+spacing = 1.0
+[[geometry.block]]
+min = [0.0, 0.0]
+max = [2.0, 2.0]
+material = "soil"
+[materials.soil]
+model = "perzyna_mohr_coulomb"
+E = 1.0e7
+nu = 0.3
+density = 2000.0
+cohesion = 10.0e3
+friction_angle = 30.0
+dilatancy = 20.0
+hardening_modulus = -1.0e5
+residual_cohesion = 2.0e3
+fluidity = 1.0
+[materials.clay]
+model = "perzyna_von_mises"
+E = 1.0e7
+nu = 0.3
+density = 2000.0
+yield_stress = 1.0e5
+fluidity = 1.0
+[materials.rock]
+model = "elastic"
+E = 1.0e9
+nu = 0.2
+density = 2500.0
+[time]
+end = 1.0
+)");
+  const fos::StrengthReduction s = fos::read_strength(load_case_document(file, {}));
+  ASSERT_EQ(s.materials.size(), 2u);
+  ASSERT_EQ(s.unreduced.size(), 1u);
+  EXPECT_EQ(s.unreduced[0], "materials.rock");
+  std::map<std::string, double> v;
+  for (const auto& [k, x] : s.values(2.0)) v[k] = x;
+  EXPECT_DOUBLE_EQ(v.at("materials.soil.cohesion"), 5.0e3);
+  EXPECT_DOUBLE_EQ(v.at("materials.soil.hardening_modulus"), -0.5e5);
+  EXPECT_DOUBLE_EQ(v.at("materials.soil.residual_cohesion"), 1.0e3);
+  // tan(phi_F) = tan(30 deg) / 2: phi_F = 16.10 deg; psi = 20 deg exceeds it and is capped.
+  EXPECT_NEAR(v.at("materials.soil.friction_angle"), 16.102113751, 1e-8);
+  EXPECT_DOUBLE_EQ(v.at("materials.soil.dilatancy"), v.at("materials.soil.friction_angle"));
+  EXPECT_DOUBLE_EQ(v.at("materials.clay.yield_stress"), 0.5e5);
+  EXPECT_EQ(v.count("materials.clay.residual_yield_stress"), 0u);  // its default follows Y0
+  // At F = 1.1 the dilatancy (20 deg) stays below phi_F (27.7 deg).
+  for (const auto& [k, x] : s.values(1.1)) v[k] = x;
+  EXPECT_DOUBLE_EQ(v.at("materials.soil.dilatancy"), 20.0);
+  // The overrides give a case the reader accepts.
+  EXPECT_NO_THROW((void)read_case<2>(load_case_document(file, s.overrides(3.0))));
+}
+
+TEST(FosRun, MonitorMissingOrOffTheBody) {
+  test::TempDir dir;
+  const std::string file = dir.write("cut.toml", kCut);
+  const fs::path out = dir.path() / "fos";
+  FosOptions o = options(file, out);
+  o.overrides = {"fos.monitor=\"top\""};
+  try {
+    run_fos(o);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("no probe named 'top' in the case (its probes: crest)"), std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("fos.monitor"), std::string::npos) << e.what();
+  }
+  o.overrides = {"fos.monitor=[12.0, 5.0]"};
+  try {
+    run_fos(o);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("is not on the body"), std::string::npos) << e.what();
+  }
+  o.overrides = {"fos.window=6.0"};
+  EXPECT_THROW(run_fos(o), InputError);
+  o.overrides = {"fos.typo=1"};
+  EXPECT_THROW(run_fos(o), InputError);
+  EXPECT_FALSE(fs::exists(out));
+}
+
+TEST(FosRun, UnreducedRunThatCollapses) {
+  test::TempDir dir;
+  const std::string file = dir.write("cut.toml", kCut);
+  const fs::path out = dir.path() / "fos";
+  FosOptions o = options(file, out);
+  o.overrides = {"material.cohesion=10000", "geometry.spacing=1.0"};  // N = 9.8
+  o.jobs = 1;
+  EXPECT_EQ(run_fos(o), kExitNoFactor);
+  const nlohmann::json j = read_json(out / "fos.json");
+  EXPECT_EQ(j["status"], "unreduced_fails");
+  EXPECT_TRUE(j["factor_of_safety"].is_null());
+  ASSERT_EQ(j["trials"].size(), 1u);
+  EXPECT_NE(j["trials"][0]["outcome"], "stable");
+  EXPECT_TRUE(fs::exists(out / "trial_01" / "probes.csv"));
+}
+
+TEST(FosRun, BracketThatDoesNotCloseKeepsItsTrials) {
+  test::TempDir dir;
+  const std::string file = dir.write("cut.toml", kCut);
+  const fs::path out = dir.path() / "fos";
+  FosOptions o = options(file, out);
+  o.max_trials = 2;  // F = 1 stands, F = 1.25 does not: the bracket is 25 % wide
+  EXPECT_EQ(run_fos(o), kExitNoFactor);
+  const nlohmann::json j = read_json(out / "fos.json");
+  EXPECT_EQ(j["status"], "bracket_open");
+  EXPECT_EQ(j["bracket"][0], 1.0);
+  EXPECT_EQ(j["bracket"][1], 1.25);
+  EXPECT_EQ(j["trials"].size(), 2u);
+  EXPECT_TRUE(fs::exists(out / "trial_02" / "summary.json"));
+  // A second search into the same folder replaces the first one's trials.
+  o.max_trials = 12;
+  o.overrides = {"geometry.spacing=1.0", "material.cohesion=10000"};
+  o.jobs = 1;
+  EXPECT_EQ(run_fos(o), kExitNoFactor);
+  EXPECT_FALSE(fs::exists(out / "trial_02"));
+}
+
+}  // namespace
+}  // namespace rktsph
