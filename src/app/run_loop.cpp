@@ -336,7 +336,12 @@ int run_loop(const LoopInput& in) {
       // V3: the pore-pressure solve (method-notes §2.4): PCG iterations, residual, time share.
       const PressureSolveStats& ps = pressure->stats();
       j["pressure_solve"] = {
-          {"preconditioner", setup.fluid.incomplete_cholesky ? "incomplete_cholesky" : "jacobi"},
+          {"preconditioner", pressure->implicit_faces()        ? "jacobi"
+                             : setup.fluid.incomplete_cholesky ? "incomplete_cholesky"
+                                                               : "jacobi"},
+          {"method", pressure->implicit_faces() ? "bicgstab" : "conjugate_gradient"},
+          {"implicit_face_nodes", pressure->implicit_faces() ? pressure->impermeable_stress_face_nodes() : 0},
+          {"undrained_courant", pressure->undrained_courant()},
           {"tolerance", setup.fluid.tolerance},
           {"unknowns", pressure->solver().unknowns()},
           {"solves", ps.solves},
@@ -365,6 +370,12 @@ int run_loop(const LoopInput& in) {
           "wait policy {})\n",
           kVersion, opt.case_file, Dim, solver.nodes().size(), solver.stress_points().size(), dt, solver.cfl(),
           total_steps, threads, threads > 1 ? "s" : "", exec::adaptive_teams() ? " (adaptive)" : "", wait_policy);
+    }
+    if (pressure != nullptr && pressure->implicit_faces()) {
+      std::cerr << fmt::format(
+          "pore pressure: {} nodes of impermeable faces that carry a total stress (or are free) taken "
+          "implicitly (undrained Courant number C c_u/c_d = {:.2f}; BiCGSTAB, method-notes §2.4)\n",
+          pressure->impermeable_stress_face_nodes(), pressure->undrained_courant());
     }
     if (pressure != nullptr && pressure->impermeable_stress_face_nodes() > 0 && !pressure->implicit_faces() &&
         pressure->undrained_courant() > PorePressureStage<Dim>::kUndrainedCourantLimit) {
@@ -491,9 +502,10 @@ int run_loop(const LoopInput& in) {
     if (pressure != nullptr) {
       const PressureSolveStats& ps = pressure->stats();
       std::cerr << fmt::format(
-          "pore pressure: {} PCG solves, iterations mean {:.1f} / max {}, final relative "
+          "pore pressure: {} {} solves, iterations mean {:.1f} / max {}, final relative "
           "residual {:.2e}; pressure step {:.0f} % of the loop time\n",
-          ps.solves, ps.mean_iterations(), ps.max_iterations, ps.last_error,
+          ps.solves, pressure->implicit_faces() ? "BiCGSTAB" : "PCG", ps.mean_iterations(), ps.max_iterations,
+          ps.last_error,
           seconds > 0 ? 100.0 * pressure->seconds() / seconds : 0.0);
     }
     const double node_steps = static_cast<double>(solver.nodes().size()) *

@@ -246,13 +246,15 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     c.fluid.incremental = s->boolean("pressure_incremental", !c.fluid.divergence_from_stress_points);
     s->require(!(c.fluid.incremental && c.fluid.divergence_from_stress_points), "pressure_incremental",
                "cannot be true with pressure_divergence = \"stress_points\" (the combination is unstable)");
-    const std::string faces = s->string("pressure_faces", "implicit");
-    if (faces == "implicit")
-      c.fluid.implicit_faces = true;
+    const std::string faces = s->string("pressure_faces", "auto");
+    if (faces == "auto")
+      c.fluid.face_condition = FluidSpec::FaceCondition::automatic;
+    else if (faces == "implicit")
+      c.fluid.face_condition = FluidSpec::FaceCondition::implicit;
     else if (faces == "explicit")
-      c.fluid.implicit_faces = false;
+      c.fluid.face_condition = FluidSpec::FaceCondition::explicit_p;
     else
-      s->fail("pressure_faces", fmt::format("unknown value '{}' (known: implicit, explicit)", faces));
+      s->fail("pressure_faces", fmt::format("unknown value '{}' (known: auto, implicit, explicit)", faces));
     c.fluid.filter = s->number("pressure_filter", 0.5);
     s->require(c.fluid.filter >= 0.0 && c.fluid.filter <= 10.0, "pressure_filter",
                fmt::format("must lie in [0, 10] (a multiple of S_w dt/rho), got {}", c.fluid.filter));

@@ -101,10 +101,12 @@ struct FluidSpec {
   /// points' pressure-free half-step velocity, with the stabilisation S_w (dt/2)/rho (source-free
   /// when the stress points are at rest; method-notes §2.4).
   bool divergence_from_stress_points = false;
-  /// solver.pressure_faces = "implicit": the effective-stress condition at impermeable faces that
-  /// carry a total stress is taken at t^{n+1} in the pressure step (method-notes eq. (2.4.16));
-  /// false ("explicit"): with p^n, stable only below C c_u/c_d = 3.5 (eq. (4.3.2)).
-  bool implicit_faces = true;
+  /// solver.pressure_faces: the effective-stress condition at impermeable faces that carry a
+  /// total stress, taken at t^{n+1} in the pressure step (implicit, method-notes eq. (2.4.16)) or
+  /// with p^n (explicit: stable only below C c_u/c_d = 3.5, eq. (4.3.2)); automatic: implicit
+  /// where the explicit form is within reach of its limit (C c_u/c_d > 2.5), else explicit.
+  enum class FaceCondition { automatic, implicit, explicit_p };
+  FaceCondition face_condition = FaceCondition::automatic;
   /// solver.pressure_filter: coefficient of the linear-exact pressure filter, in units of the
   /// fractional-step stabilisation S_w dt/rho (0 = none; method-notes §2.4).
   double filter = 0.5;

@@ -55,6 +55,9 @@ class PorePressureStage final : public Stage {
   /// Those faces are taken implicitly (solver.pressure_faces = "implicit"): the limit is gone.
   bool implicit_faces() const { return !face_coupling_.empty(); }
   static constexpr double kUndrainedCourantLimit = 3.5;
+  /// solver.pressure_faces = "auto" takes the faces implicitly above this C c_u/c_d (a margin
+  /// below the measured limit: stable at 2.7, 2.9, 3.4; unstable at 3.6).
+  static constexpr double kAutoImplicitCourant = 2.5;
   /// The growth guard's hint when the limit above is exceeded (empty otherwise).
   std::string instability_hint() const;
 
