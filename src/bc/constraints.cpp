@@ -14,6 +14,15 @@ void NodalConstraints<Dim>::resolve(const std::vector<BoundarySpec<Dim>>& specs,
                                     const BoundaryNodes<Dim>& boundary, double dx, bool free_faces) {
   const auto nn = static_cast<std::size_t>(nodes.size());
   const std::vector<std::uint8_t> node_faces = boundary.dense_faces(nodes.size());
+  // Each node's row of `boundary`, or -1 (for the polygon edges and face conditions).
+  std::vector<Index> boundary_row(nn, -1);
+  for (std::size_t b = 0; b < boundary.size(); ++b) boundary_row[static_cast<std::size_t>(boundary.node[b])] = static_cast<Index>(b);
+  auto on_edge = [&](std::size_t i, const EdgeRef& edge) {
+    const Index b = boundary_row[i];
+    if (b < 0 || !boundary.has_geometry()) return false;
+    const auto& e = boundary.edges[static_cast<std::size_t>(b)];
+    return e[0] == edge || e[1] == edge;
+  };
   std::vector<std::vector<NodalConstraint>> per_node(nn);
   // Bit k * Dim + d: v_k is prescribed at the node by an entry acting on the face with normal
   // e_d (an entry whose box is a plane x_d = const; a box that is no plane acts on every face).
@@ -71,7 +80,7 @@ void NodalConstraints<Dim>::resolve(const std::vector<BoundarySpec<Dim>>& specs,
     }
     if (planes == 0) planes = (1u << Dim) - 1u;
     for (std::size_t i = 0; i < nn; ++i) {
-      if (!spec.region.contains(nodes.position[i], tol)) continue;
+      if (spec.edge ? !on_edge(i, *spec.edge) : !spec.region.contains(nodes.position[i], tol)) continue;
       ++selected;
       for (const auto& [axis, value] : spec.velocity) {
         set(i, {axis, value, spec.function}, 1.0);
@@ -103,10 +112,28 @@ void NodalConstraints<Dim>::resolve(const std::vector<BoundarySpec<Dim>>& specs,
   // the node" alone had left all three free there (and sigma_xy free at a roller/free-top
   // corner); in Case 4(a) that left 2.4x more face-traction residual, 7x worse section
   // equilibrium and 6x more kinetic energy in the steady flow at the toe.
+  //
+  // A polygon's node with a face normal to no axis (FaceCondition other than axes) and no entry
+  // is made traction-free by rotation to its local frame instead (method-notes §3.9); one that
+  // an entry selects keeps the entry's components and those of its faces normal to an axis.
+  rotated_.clear();
+  rotated_normals_.clear();
+  rotated_corners_.clear();
   for (std::size_t i = 0; i < nn; ++i) {
     const std::uint8_t faces = node_faces[i];
     auto& list = per_node[i];
     if (!free_faces && list.empty()) continue;
+    const Index brow = boundary_row[i];
+    if (list.empty() && brow >= 0 && boundary.has_geometry()) {
+      const auto b = static_cast<std::size_t>(brow);
+      const FaceCondition condition = boundary.condition[b];
+      if (condition == FaceCondition::normal || condition == FaceCondition::corner) {
+        rotated_.push_back(static_cast<Index>(i));
+        rotated_normals_.push_back(boundary.normal[b]);
+        rotated_corners_.push_back(condition == FaceCondition::corner ? 1 : 0);
+      }
+      if (condition != FaceCondition::axes) continue;
+    }
     std::uint8_t reaction = 0;  // stress slots that are reactions at this node
     for (int d = 0; d < Dim; ++d) {
       if ((faces & (3u << (2 * d))) == 0) continue;

@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "case/particle_file_reader.hpp"
+#include "case/polygon_reader.hpp"
 #include "core/error.hpp"
 
 namespace rktsph::case_reading {
@@ -15,8 +16,10 @@ BoundarySpec<Dim> read_boundary(const io::Section& b, const CaseSetup<Dim>& c) {
   BoundarySpec<Dim> spec;
   spec.name = b.string("name", b.path());
   spec.where = b.where();
-  bool any_axis = false;
-  for (int d = 0; d < Dim; ++d) {
+  // A polygon's edge (case/polygon_reader.hpp), or a region.
+  const bool by_edge = read_boundary_edge<Dim>(b, c, spec);
+  bool any_axis = by_edge;
+  for (int d = 0; d < Dim && !by_edge; ++d) {
     const std::string axis(kAxisNames[static_cast<std::size_t>(d)]);
     if (!b.has(axis)) {
       b.number(axis, 0.0);
@@ -32,7 +35,8 @@ BoundarySpec<Dim> read_boundary(const io::Section& b, const CaseSetup<Dim>& c) {
     any_axis = true;
   }
   if (!any_axis) {
-    b.fail("", fmt::format("selects no region: give at least one of {} as [min, max]", Dim == 1 ? "x" : "x, y"));
+    b.fail("", fmt::format("selects no region: give at least one of {} as [min, max]{}", Dim == 1 ? "x" : "x, y",
+                           Dim == 2 ? ", or a polygon's edge (polygon, edge)" : ""));
   }
   if (auto v = b.optional_table("velocity")) {
     for (const std::string& axis : v->keys()) {

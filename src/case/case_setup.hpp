@@ -11,6 +11,7 @@
 #include "core/types.hpp"
 #include "materials/material.hpp"
 #include "particles/lattice.hpp"
+#include "particles/polygon.hpp"
 
 namespace rktsph {
 
@@ -53,6 +54,9 @@ struct BoundarySpec {
   std::string name;
   std::string where;  // "case.toml, line 12" for error messages
   Region<Dim> region;
+  /// An edge of a polygon body (particles/polygon.hpp) instead of a region: the entry selects
+  /// the nodes on it; `region` is then the edge's bounding box (for the partial-load average).
+  std::optional<EdgeRef> edge;
   std::vector<std::pair<int, double>> velocity;  // (axis, m/s)
   std::vector<std::pair<int, double>> stress;    // (stress slot, Pa)
   int function = -1;                             // index into CaseSetup::functions, -1 = 1
@@ -123,6 +127,10 @@ struct CaseSetup {
   double dx = 0.0;
   Vec<Dim> origin = Vec<Dim>::Zero();
   std::vector<Block<Dim>> blocks;
+  /// geometry.polygon (2D): polygon bodies (particles/polygon.hpp). The reader discretises them
+  /// into `imported` (with their faces); the geometry is kept for the edges' boundary entries
+  /// and for the commands that read it (rktsph lem).
+  std::vector<PolygonBody> polygons;
   /// geometry.jitter and geometry.jitter_seed (particles/lattice.hpp, LatticeJitter).
   LatticeJitter jitter;
   /// geometry.particles: nodes and stress points read from files (case/particle_file_reader.hpp)

@@ -9,6 +9,7 @@
 
 #include "case/size_limits.hpp"
 #include "core/error.hpp"
+#include "operators/free_surface.hpp"
 #include "schemes/registry.hpp"
 
 namespace rktsph {
@@ -149,6 +150,23 @@ StaggeredModel<Dim>::StaggeredModel(CaseSetup<Dim> case_setup, exec::Threads thr
   Relation<Dim> relation;
   relation.build(constrained_positions, stress_points.position, difference_gradient_relation_options(kernel), policy);
   constrained_gradient = build_difference_gradient<Dim>(relation, constrained_positions, stress_points, kernel);
+
+  // Faces of polygons normal to no axis (method-notes §3.9): traction-free by rotation to their
+  // geometric normal, which step 2 sees as V2 sees its detected surface (surface rows).
+  if (!constraints.rotated().empty()) {
+    if (setup.version == "v2") {
+      throw InputError(fmt::format(
+          "{}: a polygon with edges normal to no axis needs solver.free_surface = \"detect\" in V2 (its "
+          "geometric normals hold in the initial configuration only)",
+          setup.file));
+    }
+    const std::vector<Index>& which = constraints.rotated();
+    surface.row.assign(static_cast<std::size_t>(nodes.size()), -1);
+    for (std::size_t k = 0; k < which.size(); ++k) surface.row[static_cast<std::size_t>(which[k])] = static_cast<Index>(k);
+    surface.normal = constraints.rotated_normals();
+    surface.corner = constraints.rotated_corners();
+    surface.gradient = build_difference_gradient<Dim>(nodes.position, which, stress_points, kernel);
+  }
 }
 
 template <int Dim>
@@ -172,6 +190,11 @@ void StaggeredModel<Dim>::apply_constraints(double t) {
         s(i, c.component - Dim) = value;
       }
     }
+  }
+  const std::vector<Index>& rotated = constraints.rotated();
+  for (std::size_t k = 0; k < rotated.size(); ++k) {
+    make_surface_traction_free<Dim>(constraints.rotated_normals()[k], constraints.rotated_corners()[k] != 0,
+                                    s[rotated[k]]);
   }
 }
 
@@ -198,6 +221,17 @@ double StaggeredModel<Dim>::boundary_power() const {
           const double sk =
               s(i, stress_slot<Dim>(k, d)) - (pore_pressure_ != nullptr && k == d ? pore_pressure_[i] : 0.0);
           power += area * sk * normal * v(i, k);
+        }
+      }
+    }
+    if (boundary.has_geometry()) {
+      // Faces normal to no axis (polygons): A (sigma . n) . v with the sum of A n over them.
+      const Vec<Dim>& a = boundary.inclined[b];
+      for (int k = 0; k < Dim; ++k) {
+        for (int d = 0; d < Dim; ++d) {
+          const double sk =
+              s(i, stress_slot<Dim>(k, d)) - (pore_pressure_ != nullptr && k == d ? pore_pressure_[i] : 0.0);
+          power += sk * a[d] * v(i, k);
         }
       }
     }
