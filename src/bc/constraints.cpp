@@ -9,6 +9,13 @@
 
 namespace rktsph {
 
+namespace {
+template <int Dim>
+bool spec_traction_nodes(const std::vector<BoundarySpec<Dim>>& specs) {
+  return std::any_of(specs.begin(), specs.end(), [](const BoundarySpec<Dim>& s) { return s.traction.has_value(); });
+}
+}  // namespace
+
 template <int Dim>
 void NodalConstraints<Dim>::resolve(const std::vector<BoundarySpec<Dim>>& specs, const ParticleSet<Dim>& nodes,
                                     const BoundaryNodes<Dim>& boundary, double dx, bool free_faces) {
@@ -72,6 +79,15 @@ void NodalConstraints<Dim>::resolve(const std::vector<BoundarySpec<Dim>>& specs,
     return fraction;
   };
 
+  // Tractions on inclined edges, per node: (normal, tangential) and the time function; later
+  // entries override earlier ones.
+  struct EdgeTraction {
+    Vec<Dim> value = Vec<Dim>::Zero();
+    int function = -1;
+    bool given = false;
+  };
+  std::vector<EdgeTraction> edge_traction(spec_traction_nodes(specs) ? nn : 0);
+
   for (const auto& spec : specs) {
     std::size_t selected = 0;
     unsigned planes = 0;
@@ -82,6 +98,21 @@ void NodalConstraints<Dim>::resolve(const std::vector<BoundarySpec<Dim>>& specs,
     for (std::size_t i = 0; i < nn; ++i) {
       if (spec.edge ? !on_edge(i, *spec.edge) : !spec.region.contains(nodes.position[i], tol)) continue;
       ++selected;
+      if constexpr (Dim == 2) {
+        if (spec.traction) {
+          // A vertex carries half (of its two half pieces, one is this edge's); the tractions
+          // of the two edges meeting there add (with one time function; else the later wins).
+          const auto& e = boundary.edges[static_cast<std::size_t>(boundary_row[i])];
+          const double share = e[1].edge >= 0 ? 0.5 : 1.0;
+          const Vec<Dim> value = share * Vec<Dim>((*spec.traction)[0], (*spec.traction)[1]);
+          EdgeTraction& et = edge_traction[i];
+          const bool add = et.given && et.function == spec.function && share < 1.0;
+          et.value = add ? Vec<Dim>(et.value + value) : value;
+          et.function = spec.function;
+          et.given = true;
+          continue;
+        }
+      }
       for (const auto& [axis, value] : spec.velocity) {
         set(i, {axis, value, spec.function}, 1.0);
         for (int d = 0; d < Dim; ++d) {
@@ -119,6 +150,8 @@ void NodalConstraints<Dim>::resolve(const std::vector<BoundarySpec<Dim>>& specs,
   rotated_.clear();
   rotated_normals_.clear();
   rotated_corners_.clear();
+  rotated_tractions_.clear();
+  rotated_functions_.clear();
   for (std::size_t i = 0; i < nn; ++i) {
     const std::uint8_t faces = node_faces[i];
     auto& list = per_node[i];
@@ -127,10 +160,13 @@ void NodalConstraints<Dim>::resolve(const std::vector<BoundarySpec<Dim>>& specs,
     if (list.empty() && brow >= 0 && boundary.has_geometry()) {
       const auto b = static_cast<std::size_t>(brow);
       const FaceCondition condition = boundary.condition[b];
-      if (condition == FaceCondition::normal || condition == FaceCondition::corner) {
+      const bool loaded = !edge_traction.empty() && edge_traction[i].given;
+      if (loaded || condition == FaceCondition::normal || condition == FaceCondition::corner) {
         rotated_.push_back(static_cast<Index>(i));
         rotated_normals_.push_back(boundary.normal[b]);
-        rotated_corners_.push_back(condition == FaceCondition::corner ? 1 : 0);
+        rotated_corners_.push_back(condition == FaceCondition::corner && !loaded ? 1 : 0);
+        rotated_tractions_.push_back(loaded ? edge_traction[i].value : Vec<Dim>::Zero());
+        rotated_functions_.push_back(loaded ? edge_traction[i].function : -1);
       }
       if (condition != FaceCondition::axes) continue;
     }

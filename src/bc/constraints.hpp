@@ -42,6 +42,12 @@ class NodalConstraints {
   const std::vector<Index>& rotated() const { return rotated_; }
   const std::vector<Vec<Dim>>& rotated_normals() const { return rotated_normals_; }
   const std::vector<std::uint8_t>& rotated_corners() const { return rotated_corners_; }
+  /// The traction (normal, tangential; Pa, tension positive) prescribed at rotated()[k] by an
+  /// entry's `traction` on an inclined edge (zero: traction-free), scaled by the time function
+  /// rotated_functions()[k] (-1 = 1). At such a node the face condition is used about its normal
+  /// even at a corner.
+  const std::vector<Vec<Dim>>& rotated_tractions() const { return rotated_tractions_; }
+  const std::vector<int>& rotated_functions() const { return rotated_functions_; }
 
   /// Constraints of node i: list()[k] for k in [row(i), row(i + 1)), sorted by component.
   Index begin(Index i) const { return row_[static_cast<std::size_t>(i)]; }
@@ -64,6 +70,8 @@ class NodalConstraints {
   std::vector<Index> rotated_;
   std::vector<Vec<Dim>> rotated_normals_;
   std::vector<std::uint8_t> rotated_corners_;
+  std::vector<Vec<Dim>> rotated_tractions_;
+  std::vector<int> rotated_functions_;
 };
 
 }  // namespace rktsph

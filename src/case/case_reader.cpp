@@ -362,6 +362,9 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     root.fail("fluid", "missing: solver.version = \"v3\" needs a [fluid] table");
   }
   for (const auto& b : c.boundaries) {
+    if (b.traction && c.version != "v1") {
+      throw InputError(fmt::format("{}: a traction on a polygon edge needs solver.version = \"v1\"", b.where));
+    }
     if (!saturated && (b.pore_pressure || b.impermeable)) {
       throw InputError(fmt::format("{}: pore_pressure / impermeable need solver.version = \"v3\"", b.where));
     }

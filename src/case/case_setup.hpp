@@ -59,6 +59,9 @@ struct BoundarySpec {
   std::optional<EdgeRef> edge;
   std::vector<std::pair<int, double>> velocity;  // (axis, m/s)
   std::vector<std::pair<int, double>> stress;    // (stress slot, Pa)
+  /// On a polygon edge normal to no axis: the traction (normal, tangential) in Pa, tension
+  /// positive, t = e_z x n (method-notes §3.9), imposed by the rotation of §3.7.
+  std::optional<std::array<double, 2>> traction;
   int function = -1;                             // index into CaseSetup::functions, -1 = 1
   // V3 (saturated) pore-pressure conditions, method-notes §4.1: a drained face (p_w prescribed,
   // Pa, scaled by `function`) or an explicitly impermeable one (dp_w/dn = 0, the default).

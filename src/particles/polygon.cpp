@@ -638,6 +638,7 @@ LatticeParticles<2> generate_polygon_particles(const std::vector<PolygonBody>& b
         normal = two ? P((e.faces[0].normal + e.faces[1].normal).normalized()) : e.faces[0].normal;
       } else {
         condition = e.convex ? FaceCondition::corner : FaceCondition::none;
+        normal = P((e.faces[0].normal + e.faces[1].normal).normalized());  // for a traction there
       }
       bn.node.push_back(out.nodes.size());
       bn.faces.push_back(faces);

@@ -166,6 +166,11 @@ StaggeredModel<Dim>::StaggeredModel(CaseSetup<Dim> case_setup, exec::Threads thr
     surface.normal = constraints.rotated_normals();
     surface.corner = constraints.rotated_corners();
     surface.gradient = build_difference_gradient<Dim>(nodes.position, which, stress_points, kernel);
+    const auto& tractions = constraints.rotated_tractions();
+    if (std::any_of(tractions.begin(), tractions.end(), [](const Vec<Dim>& t) { return t.squaredNorm() > 0.0; })) {
+      surface.traction = tractions;
+      surface.traction_function = constraints.rotated_functions();
+    }
   }
 }
 
@@ -193,8 +198,28 @@ void StaggeredModel<Dim>::apply_constraints(double t) {
   }
   const std::vector<Index>& rotated = constraints.rotated();
   for (std::size_t k = 0; k < rotated.size(); ++k) {
-    make_surface_traction_free<Dim>(constraints.rotated_normals()[k], constraints.rotated_corners()[k] != 0,
-                                    s[rotated[k]]);
+    double* sigma = s[rotated[k]];
+    make_surface_traction_free<Dim>(constraints.rotated_normals()[k], constraints.rotated_corners()[k] != 0, sigma);
+    if (!surface.traction.empty()) add_surface_traction(k, t, sigma);
+  }
+}
+
+template <int Dim>
+void StaggeredModel<Dim>::add_surface_traction(std::size_t row, double t, double* sigma) const {
+  if constexpr (Dim == 2) {
+    // method-notes eq. (3.7.2) with sigma_nn = t_n, sigma_nt = t_t and sigma_tt = 0: the part of
+    // the stress that the condition prescribes (added to the traction-free part).
+    const Vec<Dim>& n = surface.normal[row];
+    const double f = function_value(surface.traction_function[row], t);
+    const double snn = f * surface.traction[row][0], snt = f * surface.traction[row][1];
+    const double c = n[0], sn = n[1];
+    sigma[stress_slot<Dim>(0, 0)] += c * c * snn - 2.0 * sn * c * snt;
+    sigma[stress_slot<Dim>(1, 1)] += sn * sn * snn + 2.0 * sn * c * snt;
+    sigma[stress_slot<Dim>(0, 1)] += sn * c * snn + (c * c - sn * sn) * snt;
+  } else {
+    (void)row;
+    (void)t;
+    (void)sigma;
   }
 }
 
