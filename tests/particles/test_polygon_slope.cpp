@@ -242,6 +242,40 @@ cfl = 0.5
   EXPECT_LT(worst_sp / p, 2e-3);
 }
 
+// An entry by a hole's edge selects the nodes on that edge, its two vertices included.
+TEST(PolygonCase, AHoleEdgeEntrySelectsTheNodesOnIt) {
+  test::TempDir dir;
+  const std::string text = std::string(R"(
+[geometry]
+dimension = 2
+spacing = 0.25
+[[geometry.polygon]]
+vertices = [[0.0, 0.0], [4.0, 0.0], [4.0, 4.0], [0.0, 4.0]]
+holes = [[[1.0, 1.0], [1.3, 2.9], [3.1, 2.6], [2.7, 1.2]]]
+[[boundary]]
+polygon = 0
+hole = 0
+edge = 1
+velocity = { x = 0.0, y = 0.0 }
+)") + kPlate;
+  Simulation<2> sim(test::case_from_string<2>(dir, text));
+  const Vec<2> a(1.3, 2.9), b(3.1, 2.6);
+  const Vec<2> t = (b - a).normalized();
+  std::size_t selected = 0;
+  for (const Index i : sim.model().constraints.constrained()) {
+    bool fixed = false;
+    for (Index k = sim.model().constraints.begin(i); k < sim.model().constraints.end(i); ++k)
+      fixed = fixed || sim.model().constraints[k].component < 2;
+    if (!fixed) continue;
+    ++selected;
+    const Vec<2> x = sim.nodes().position[static_cast<std::size_t>(i)] - a;
+    EXPECT_NEAR(x[0] * t[1] - x[1] * t[0], 0.0, 1e-12);  // on the edge's line
+    EXPECT_GE(x.dot(t), -1e-12);
+    EXPECT_LE(x.dot(t), (b - a).norm() + 1e-12);
+  }
+  EXPECT_EQ(selected, static_cast<std::size_t>(std::ceil((b - a).norm() / 0.25)) + 1);
+}
+
 TEST(PolygonCase, BadPolygonsAndEdgesNameTheFileLineAndKey) {
   test::TempDir dir;
   auto error_of = [&](const std::string& geometry, const std::string& boundary = "") {
@@ -273,6 +307,8 @@ TEST(PolygonCase, BadPolygonsAndEdgesNameTheFileLineAndKey) {
       {"[[geometry.block]]\nmin = [0.0, 0.0]\nmax = [1.0, 1.0]\n", "[[boundary]]\nedge = 0\nvelocity = { x = 0.0 }\n",
        "boundary[0].edge", "no [[geometry.polygon]]"},
       {square + "[[geometry.block]]\nmin = [0.0, 0.0]\nmax = [1.0, 1.0]\n", "", "geometry.polygon[0]", "not both"},
+      {square, "[[boundary]]\npolygon = 0\nhole = 0\nedge = 0\nvelocity = { x = 0.0 }\n", "boundary[0].hole",
+       "no hole 0"},
       {square, "[[boundary]]\npolygon = 0\nedge = 1\ntraction = { n = -1.0 }\n", "boundary[0].traction",
        "normal to no axis"},
       {"[[geometry.block]]\nmin = [0.0, 0.0]\nmax = [1.0, 1.0]\n", "[[boundary]]\ny = [0.0, 0.0]\ntraction = { n = -1.0 }\n",
