@@ -9,11 +9,27 @@
 
 namespace rktsph {
 
+namespace {
+template <int Dim>
+bool spec_traction_nodes(const std::vector<BoundarySpec<Dim>>& specs) {
+  return std::any_of(specs.begin(), specs.end(), [](const BoundarySpec<Dim>& s) { return s.traction.has_value(); });
+}
+}  // namespace
+
 template <int Dim>
 void NodalConstraints<Dim>::resolve(const std::vector<BoundarySpec<Dim>>& specs, const ParticleSet<Dim>& nodes,
                                     const BoundaryNodes<Dim>& boundary, double dx, bool free_faces) {
   const auto nn = static_cast<std::size_t>(nodes.size());
   const std::vector<std::uint8_t> node_faces = boundary.dense_faces(nodes.size());
+  // Each node's row of `boundary`, or -1 (for the polygon edges and face conditions).
+  std::vector<Index> boundary_row(nn, -1);
+  for (std::size_t b = 0; b < boundary.size(); ++b) boundary_row[static_cast<std::size_t>(boundary.node[b])] = static_cast<Index>(b);
+  auto on_edge = [&](std::size_t i, const EdgeRef& edge) {
+    const Index b = boundary_row[i];
+    if (b < 0 || !boundary.has_geometry()) return false;
+    const auto& e = boundary.edges[static_cast<std::size_t>(b)];
+    return e[0] == edge || e[1] == edge;
+  };
   std::vector<std::vector<NodalConstraint>> per_node(nn);
   // Bit k * Dim + d: v_k is prescribed at the node by an entry acting on the face with normal
   // e_d (an entry whose box is a plane x_d = const; a box that is no plane acts on every face).
@@ -63,6 +79,15 @@ void NodalConstraints<Dim>::resolve(const std::vector<BoundarySpec<Dim>>& specs,
     return fraction;
   };
 
+  // Tractions on inclined edges, per node: (normal, tangential) and the time function; later
+  // entries override earlier ones.
+  struct EdgeTraction {
+    Vec<Dim> value = Vec<Dim>::Zero();
+    int function = -1;
+    bool given = false;
+  };
+  std::vector<EdgeTraction> edge_traction(spec_traction_nodes(specs) ? nn : 0);
+
   for (const auto& spec : specs) {
     std::size_t selected = 0;
     unsigned planes = 0;
@@ -71,8 +96,23 @@ void NodalConstraints<Dim>::resolve(const std::vector<BoundarySpec<Dim>>& specs,
     }
     if (planes == 0) planes = (1u << Dim) - 1u;
     for (std::size_t i = 0; i < nn; ++i) {
-      if (!spec.region.contains(nodes.position[i], tol)) continue;
+      if (spec.edge ? !on_edge(i, *spec.edge) : !spec.region.contains(nodes.position[i], tol)) continue;
       ++selected;
+      if constexpr (Dim == 2) {
+        if (spec.traction) {
+          // A vertex carries half (of its two half pieces, one is this edge's); the tractions
+          // of the two edges meeting there add (with one time function; else the later wins).
+          const auto& e = boundary.edges[static_cast<std::size_t>(boundary_row[i])];
+          const double share = e[1].edge >= 0 ? 0.5 : 1.0;
+          const Vec<Dim> value = share * Vec<Dim>((*spec.traction)[0], (*spec.traction)[1]);
+          EdgeTraction& et = edge_traction[i];
+          const bool add = et.given && et.function == spec.function && share < 1.0;
+          et.value = add ? Vec<Dim>(et.value + value) : value;
+          et.function = spec.function;
+          et.given = true;
+          continue;
+        }
+      }
       for (const auto& [axis, value] : spec.velocity) {
         set(i, {axis, value, spec.function}, 1.0);
         for (int d = 0; d < Dim; ++d) {
@@ -103,10 +143,33 @@ void NodalConstraints<Dim>::resolve(const std::vector<BoundarySpec<Dim>>& specs,
   // the node" alone had left all three free there (and sigma_xy free at a roller/free-top
   // corner); in Case 4(a) that left 2.4x more face-traction residual, 7x worse section
   // equilibrium and 6x more kinetic energy in the steady flow at the toe.
+  //
+  // A polygon's node with a face normal to no axis (FaceCondition other than axes) and no entry
+  // is made traction-free by rotation to its local frame instead (method-notes §3.9); one that
+  // an entry selects keeps the entry's components and those of its faces normal to an axis.
+  rotated_.clear();
+  rotated_normals_.clear();
+  rotated_corners_.clear();
+  rotated_tractions_.clear();
+  rotated_functions_.clear();
   for (std::size_t i = 0; i < nn; ++i) {
     const std::uint8_t faces = node_faces[i];
     auto& list = per_node[i];
     if (!free_faces && list.empty()) continue;
+    const Index brow = boundary_row[i];
+    if (list.empty() && brow >= 0 && boundary.has_geometry()) {
+      const auto b = static_cast<std::size_t>(brow);
+      const FaceCondition condition = boundary.condition[b];
+      const bool loaded = !edge_traction.empty() && edge_traction[i].given;
+      if (loaded || condition == FaceCondition::normal || condition == FaceCondition::corner) {
+        rotated_.push_back(static_cast<Index>(i));
+        rotated_normals_.push_back(boundary.normal[b]);
+        rotated_corners_.push_back(condition == FaceCondition::corner && !loaded ? 1 : 0);
+        rotated_tractions_.push_back(loaded ? edge_traction[i].value : Vec<Dim>::Zero());
+        rotated_functions_.push_back(loaded ? edge_traction[i].function : -1);
+      }
+      if (condition != FaceCondition::axes) continue;
+    }
     std::uint8_t reaction = 0;  // stress slots that are reactions at this node
     for (int d = 0; d < Dim; ++d) {
       if ((faces & (3u << (2 * d))) == 0) continue;

@@ -34,6 +34,21 @@ class NodalConstraints {
   void resolve(const std::vector<BoundarySpec<Dim>>& specs, const ParticleSet<Dim>& nodes,
                const BoundaryNodes<Dim>& boundary, double dx, bool free_faces = true);
 
+  /// The face nodes of polygon bodies made traction-free by rotation to their local frame
+  /// (method-notes §3.7, §3.9): sigma.n = 0 about rotated_normals()[k] at node rotated()[k], or
+  /// no in-plane stress where rotated_corners()[k] is 1. A node a boundary entry selects keeps
+  /// the entry's conditions (and those of its faces normal to an axis) instead. Empty unless
+  /// `free_faces` and the boundary has faces normal to no axis.
+  const std::vector<Index>& rotated() const { return rotated_; }
+  const std::vector<Vec<Dim>>& rotated_normals() const { return rotated_normals_; }
+  const std::vector<std::uint8_t>& rotated_corners() const { return rotated_corners_; }
+  /// The traction (normal, tangential; Pa, tension positive) prescribed at rotated()[k] by an
+  /// entry's `traction` on an inclined edge (zero: traction-free), scaled by the time function
+  /// rotated_functions()[k] (-1 = 1). At such a node the face condition is used about its normal
+  /// even at a corner.
+  const std::vector<Vec<Dim>>& rotated_tractions() const { return rotated_tractions_; }
+  const std::vector<int>& rotated_functions() const { return rotated_functions_; }
+
   /// Constraints of node i: list()[k] for k in [row(i), row(i + 1)), sorted by component.
   Index begin(Index i) const { return row_[static_cast<std::size_t>(i)]; }
   Index end(Index i) const { return row_[static_cast<std::size_t>(i) + 1]; }
@@ -52,6 +67,11 @@ class NodalConstraints {
   std::vector<NodalConstraint> list_;
   std::vector<Index> constrained_;
   std::vector<Index> constrained_row_;
+  std::vector<Index> rotated_;
+  std::vector<Vec<Dim>> rotated_normals_;
+  std::vector<std::uint8_t> rotated_corners_;
+  std::vector<Vec<Dim>> rotated_tractions_;
+  std::vector<int> rotated_functions_;
 };
 
 }  // namespace rktsph

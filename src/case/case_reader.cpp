@@ -13,6 +13,7 @@
 
 #include "case/case_reader.hpp"
 #include "case/case_reader_sections.hpp"
+#include "case/polygon_reader.hpp"
 #include "case/material_reader.hpp"
 #include "case/size_limits.hpp"
 #include "core/error.hpp"
@@ -97,11 +98,23 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     c.jitter.seed = static_cast<std::uint64_t>(seed);
     const auto blocks = g.tables("block");
     const auto particle_files = g.tables("particles");
+    const auto polygons = g.tables("polygon");
     if (!blocks.empty() && !particle_files.empty()) {
       particle_files.front().fail("", "give either [[geometry.block]] or [[geometry.particles]], not both");
     }
-    if (blocks.empty() && particle_files.empty()) {
-      g.fail("block", "missing: the geometry needs at least one [[geometry.block]] (or [[geometry.particles]])");
+    if (!polygons.empty() && (!blocks.empty() || !particle_files.empty())) {
+      polygons.front().fail("", fmt::format("give either [[geometry.polygon]] or [[geometry.{}]], not both",
+                                            blocks.empty() ? "particles" : "block"));
+    }
+    if (blocks.empty() && particle_files.empty() && polygons.empty()) {
+      g.fail("block",
+             "missing: the geometry needs at least one [[geometry.block]] (or [[geometry.polygon]], or "
+             "[[geometry.particles]])");
+    }
+    if (!polygons.empty()) {
+      // Polygon bodies (case/polygon_reader.hpp): discretised here, carried as particles with faces.
+      if (c.jitter.fraction > 0.0) g.fail("jitter", "applies to lattices generated from [[geometry.block]], not to polygons");
+      read_polygons<Dim>(g, polygons, c);
     }
     if (!particle_files.empty()) {
       particles_where = particle_files.front().where();
@@ -310,6 +323,19 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
 
   // ---- V3: the pore fluid (docs/case-format.md, "Saturated soil (V3)")
   const bool saturated = find_scheme<Dim>(c.version)->pore_fluid;
+  if (!c.polygons.empty()) {
+    if (saturated) {
+      g.fail("polygon", "polygon bodies are not available with solver.version = \"v3\" yet (the pore-pressure "
+                        "conditions act on faces normal to an axis only)");
+    }
+    const auto& conditions = c.imported->boundary.condition;
+    const bool inclined = std::any_of(conditions.begin(), conditions.end(),
+                                      [](FaceCondition f) { return f != FaceCondition::axes; });
+    if (inclined && c.version == "v2" && !c.detect_free_surface) {
+      g.fail("polygon", "a polygon with edges normal to no axis needs solver.free_surface = \"detect\" in V2 "
+                        "(its geometric normals hold in the initial configuration only)");
+    }
+  }
   if (auto f = root.optional_table("fluid")) {
     if (!saturated) f->fail("porosity", "a [fluid] table needs solver.version = \"v3\"");
     FluidSpec& fl = c.fluid;
@@ -339,6 +365,9 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     root.fail("fluid", "missing: solver.version = \"v3\" needs a [fluid] table");
   }
   for (const auto& b : c.boundaries) {
+    if (b.traction && c.version != "v1") {
+      throw InputError(fmt::format("{}: a traction on a polygon edge needs solver.version = \"v1\"", b.where));
+    }
     if (!saturated && (b.pore_pressure || b.impermeable)) {
       throw InputError(fmt::format("{}: pore_pressure / impermeable need solver.version = \"v3\"", b.where));
     }

@@ -7,6 +7,7 @@
 
 #include "case/initial_velocity.hpp"
 #include "case/particle_file_reader.hpp"
+#include "case/polygon_reader.hpp"
 #include "core/error.hpp"
 
 namespace rktsph::case_reading {
@@ -42,8 +43,11 @@ BoundarySpec<Dim> read_boundary(const io::Section& b, const CaseSetup<Dim>& c) {
   BoundarySpec<Dim> spec;
   spec.name = b.string("name", b.path());
   spec.where = b.where();
-  if (!read_axis_ranges(b, spec.region)) {
-    b.fail("", fmt::format("selects no region: give at least one of {} as [min, max]", Dim == 1 ? "x" : "x, y"));
+  // A polygon's edge (case/polygon_reader.hpp), or a region.
+  const bool by_edge = read_boundary_edge<Dim>(b, c, spec);
+  if (!by_edge && !read_axis_ranges(b, spec.region)) {
+    b.fail("", fmt::format("selects no region: give at least one of {} as [min, max]{}", Dim == 1 ? "x" : "x, y",
+                           Dim == 2 ? ", or a polygon's edge (polygon, edge)" : ""));
   }
   if (auto v = b.optional_table("velocity")) {
     for (const std::string& axis : v->keys()) {
@@ -72,6 +76,21 @@ BoundarySpec<Dim> read_boundary(const io::Section& b, const CaseSetup<Dim>& c) {
     }
     st->finish();
   }
+  if (auto tr = b.optional_table("traction")) {
+    // A traction on an inclined polygon edge (method-notes §3.9), about the edge's normal.
+    if (!spec.edge) tr->fail("", "acts on a polygon edge normal to no axis: select it with polygon and edge");
+    const Ring& ring = c.polygons[static_cast<std::size_t>(spec.edge->body)].ring(spec.edge->ring);
+    const Vec<2> d = ring[(static_cast<std::size_t>(spec.edge->edge) + 1) % ring.size()] -
+                     ring[static_cast<std::size_t>(spec.edge->edge)];
+    if (d[0] == 0.0 || d[1] == 0.0) {
+      tr->fail("", "acts on edges normal to no axis; on this edge give the stress components (stress = {...})");
+    }
+    if (!spec.velocity.empty() || !spec.stress.empty()) {
+      tr->fail("", "give either a traction or velocity / stress components on an edge, not both");
+    }
+    spec.traction = std::array<double, 2>{tr->number("n", 0.0), tr->number("t", 0.0)};
+    tr->finish();
+  }
   // V3 pore-pressure conditions (checked against solver.version below).
   if (b.has("pore_pressure"))
     spec.pore_pressure = b.number("pore_pressure");
@@ -81,7 +100,7 @@ BoundarySpec<Dim> read_boundary(const io::Section& b, const CaseSetup<Dim>& c) {
   if (spec.pore_pressure && spec.impermeable) {
     b.fail("impermeable", "a face is either drained (pore_pressure) or impermeable, not both");
   }
-  if (spec.velocity.empty() && spec.stress.empty() && !spec.pore_pressure && !spec.impermeable) {
+  if (spec.velocity.empty() && spec.stress.empty() && !spec.traction && !spec.pore_pressure && !spec.impermeable) {
     b.fail("",
            "prescribes nothing: give a velocity = {...} or stress = {...} table (or, with "
            "solver.version = \"v3\", pore_pressure or impermeable)");

@@ -11,6 +11,7 @@
 #include "core/types.hpp"
 #include "materials/material.hpp"
 #include "particles/lattice.hpp"
+#include "particles/polygon.hpp"
 
 namespace rktsph {
 
@@ -70,8 +71,14 @@ struct BoundarySpec {
   std::string name;
   std::string where;  // "case.toml, line 12" for error messages
   Region<Dim> region;
+  /// An edge of a polygon body (particles/polygon.hpp) instead of a region: the entry selects
+  /// the nodes on it; `region` is then the edge's bounding box (for the partial-load average).
+  std::optional<EdgeRef> edge;
   std::vector<std::pair<int, double>> velocity;  // (axis, m/s)
   std::vector<std::pair<int, double>> stress;    // (stress slot, Pa)
+  /// On a polygon edge normal to no axis: the traction (normal, tangential) in Pa, tension
+  /// positive, t = e_z x n (method-notes §3.9), imposed by the rotation of §3.7.
+  std::optional<std::array<double, 2>> traction;
   int function = -1;                             // index into CaseSetup::functions, -1 = 1
   // V3 (saturated) pore-pressure conditions, method-notes §4.1: a drained face (p_w prescribed,
   // Pa, scaled by `function`) or an explicitly impermeable one (dp_w/dn = 0, the default).
@@ -146,6 +153,10 @@ struct CaseSetup {
   double dx = 0.0;
   Vec<Dim> origin = Vec<Dim>::Zero();
   std::vector<Block<Dim>> blocks;
+  /// geometry.polygon (2D): polygon bodies (particles/polygon.hpp). The reader discretises them
+  /// into `imported` (with their faces); the geometry is kept for the edges' boundary entries
+  /// and for the commands that read it (rktsph lem).
+  std::vector<PolygonBody> polygons;
   /// geometry.jitter and geometry.jitter_seed (particles/lattice.hpp, LatticeJitter).
   LatticeJitter jitter;
   /// geometry.particles: nodes and stress points read from files (case/particle_file_reader.hpp)

@@ -163,6 +163,53 @@ std::vector<double> Section::numbers(std::string_view key) const {
   return out;
 }
 
+namespace {
+// The rows of an array of arrays of `width` numbers; `fail` reports with a message.
+std::vector<std::vector<double>> rows_of(const toml::node& n, std::size_t width, std::string_view what,
+                                         const Section& s, std::string_view key) {
+  auto fail = [&](std::string_view m) { s.fail(key, m); };
+  const toml::array* arr = n.as_array();
+  if (arr == nullptr) s.fail(key, fmt::format("must be {}, got {}", what, type_name(n)));
+  std::vector<std::vector<double>> out;
+  for (const toml::node& row : *arr) {
+    const toml::array* r = row.as_array();
+    if (r == nullptr || r->size() != width) {
+      s.fail(key, fmt::format("must be {}; element {} is {}", what, out.size(),
+                       r == nullptr ? std::string(type_name(row)) : fmt::format("an array of {} values", r->size())));
+    }
+    std::vector<double> values;
+    for (const toml::node& item : *r) {
+      const std::optional<double> value = number_value(item);
+      if (!value) fail(fmt::format("must be {}, but element {} holds {}", what, out.size(), type_name(item)));
+      if (!std::isfinite(*value)) fail("must hold finite numbers");
+      if (!(std::abs(*value) <= Section::kMaxMagnitude)) fail(magnitude_message(*value));
+      values.push_back(*value);
+    }
+    out.push_back(std::move(values));
+  }
+  return out;
+}
+}  // namespace
+
+std::vector<std::vector<double>> Section::number_rows(std::string_view key, std::size_t width) const {
+  const std::string what = fmt::format("an array of [{}] points", width == 2 ? "x, y" : "x, y, z");
+  return rows_of(required(key), width, what, *this, key);
+}
+
+std::vector<std::vector<std::vector<double>>> Section::number_row_lists(std::string_view key,
+                                                                       std::size_t width) const {
+  const toml::node& n = required(key);
+  const toml::array* arr = n.as_array();
+  if (arr == nullptr) fail(key, fmt::format("must be an array of arrays of points, got {}", type_name(n)));
+  std::vector<std::vector<std::vector<double>>> out;
+  for (const toml::node& list : *arr) {
+    const std::string what =
+        fmt::format("an array of arrays of [{}] points (element {})", width == 2 ? "x, y" : "x, y, z", out.size());
+    out.push_back(rows_of(list, width, what, *this, key));
+  }
+  return out;
+}
+
 std::vector<std::string> Section::strings(std::string_view key) const {
   const toml::node& n = required(key);
   const toml::array* arr = n.as_array();

@@ -45,6 +45,11 @@ class Section {
   bool boolean(std::string_view key, bool fallback) const;
   std::vector<double> numbers(std::string_view key) const;
   std::vector<std::string> strings(std::string_view key) const;
+  /// An array of arrays of numbers, e.g. a polygon's vertices [[x, y], ...]; every inner array
+  /// must have `width` numbers.
+  std::vector<std::vector<double>> number_rows(std::string_view key, std::size_t width) const;
+  /// An array of such arrays, e.g. a polygon's holes [[[x, y], ...], ...].
+  std::vector<std::vector<std::vector<double>>> number_row_lists(std::string_view key, std::size_t width) const;
 
   /// Value checks: fail with a message naming the key when the condition does not hold.
   double positive(std::string_view key) const;

@@ -9,6 +9,9 @@
 
 namespace rktsph {
 
+double lattice_vertex(double origin, int i, double dx) { return origin + i * dx; }
+double lattice_cell_centre(double origin, int i, double dx) { return origin + (i + 0.5) * dx; }
+
 template <int Dim>
 std::size_t Lattice<Dim>::cell_index(const std::array<int, Dim>& c) const {
   std::size_t idx = 0;
@@ -114,7 +117,7 @@ LatticeParticles<Dim> generate_lattice(const std::vector<Block<Dim>>& blocks, do
   }
   // Shift so that the lattice starts at the lowest block corner.
   for (std::size_t d = 0; d < Dim; ++d) {
-    lat.origin[static_cast<int>(d)] = origin[static_cast<int>(d)] + lo[d] * dx;
+    lat.origin[static_cast<int>(d)] = lattice_vertex(origin[static_cast<int>(d)], lo[d], dx);
     lat.cells[d] = hi[d] - lo[d];
   }
   std::size_t ncells = 1;
@@ -143,7 +146,7 @@ LatticeParticles<Dim> generate_lattice(const std::vector<Block<Dim>>& blocks, do
     if (m < 0) return;
     Vec<Dim> x;
     for (std::size_t d = 0; d < Dim; ++d) {
-      x[static_cast<int>(d)] = lat.origin[static_cast<int>(d)] + (c[d] + 0.5) * dx;
+      x[static_cast<int>(d)] = lattice_cell_centre(lat.origin[static_cast<int>(d)], c[d], dx);
     }
     out.stress_points.add(x, cell_volume, densities[static_cast<std::size_t>(m)], m);
   });
@@ -188,7 +191,7 @@ LatticeParticles<Dim> generate_lattice(const std::vector<Block<Dim>>& blocks, do
     if (material < 0) return;
     Vec<Dim> x;
     for (std::size_t d = 0; d < Dim; ++d) {
-      x[static_cast<int>(d)] = lat.origin[static_cast<int>(d)] + v[d] * dx;
+      x[static_cast<int>(d)] = lattice_vertex(lat.origin[static_cast<int>(d)], v[d], dx);
     }
     std::uint8_t faces = 0;
     std::array<double, 2 * Dim> area{};

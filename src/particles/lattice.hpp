@@ -40,15 +40,43 @@ struct Lattice {
   int material_at(const std::array<int, Dim>& c) const;
 };
 
+/// An edge of a polygon body (particles/polygon.hpp) that a boundary node lies on: the body,
+/// the ring (0 the outer boundary, 1 + j hole j) and the edge (k from vertex k to vertex k + 1).
+struct EdgeRef {
+  int body = -1;
+  int ring = -1;
+  int edge = -1;
+  bool operator==(const EdgeRef&) const = default;
+};
+
+/// The traction-free condition at a boundary node of a polygon (method-notes §3.9):
+///   axes   - every face of the node is normal to an axis: the face bits hold, as on a lattice;
+///   normal - sigma.n = 0 about the node's unit normal (one inclined face, or two faces meeting
+///            at a vertex that turns by at most kCornerTurn: their bisector);
+///   corner - two faces at a convex vertex turning by more: no in-plane stress;
+///   none   - a re-entrant vertex turning by more (as a lattice's inner corner: no condition).
+enum class FaceCondition : std::uint8_t { axes = 0, normal = 1, corner = 2, none = 3 };
+
 /// The nodes on the faces of the body, with the faces each lies on (bit 2d of `faces`: the face
 /// with outward normal -e_d; bit 2d+1: +e_d) and its tributary area of each face, m^(Dim-1).
 /// Kept as a sorted list of node indices, not as node fields: the faces are a small part of a
 /// large set. remap() follows a reordering of the nodes.
+///
+/// Polygon bodies add faces of any inclination: `inclined` is the sum of A n over the node's
+/// faces that are normal to no axis (its length the area of a single one), `normal` and
+/// `condition` the traction-free condition there, `edges` the polygon edges it lies on (two at
+/// a vertex). These four are empty for lattices and particle files, else parallel to `node`.
 template <int Dim>
 struct BoundaryNodes {
   std::vector<Index> node;  // ascending
   std::vector<std::uint8_t> faces;
   std::vector<std::array<double, 2 * Dim>> area;
+  std::vector<Vec<Dim>> inclined;
+  std::vector<Vec<Dim>> normal;
+  std::vector<FaceCondition> condition;
+  std::vector<std::array<EdgeRef, 2>> edges;
+
+  bool has_geometry() const { return !condition.empty(); }
 
   std::size_t size() const { return node.size(); }
   /// The face areas of node i (zeros for a node on no face).
@@ -77,6 +105,12 @@ struct BoundaryNodes {
       out.node.push_back(node[k]);
       out.faces.push_back(faces[k]);
       out.area.push_back(area[k]);
+      if (has_geometry()) {
+        out.inclined.push_back(inclined[k]);
+        out.normal.push_back(normal[k]);
+        out.condition.push_back(condition[k]);
+        out.edges.push_back(edges[k]);
+      }
     }
     *this = std::move(out);
   }
@@ -108,6 +142,14 @@ struct LatticeParticles {
   ParticleSet<Dim> stress_points{"stress_points"};
   BoundaryNodes<Dim> boundary;
 };
+
+/// The coordinates of lattice vertex `i` and of the centre of cell `i` along one axis. Out of
+/// line, so that every generator (blocks, polygons) gets the same bits whatever the compiler
+/// contracts in its own loops (with -march=native, origin + i dx may become a fused
+/// multiply-add in one place and not in another).
+double lattice_vertex(double origin, int i, double dx);
+double lattice_cell_centre(double origin, int i, double dx);
+
 
 /// Build nodes and stress points from blocks (all on one lattice of spacing dx starting at
 /// `origin`), displaced by `jitter`. Throws InputError naming the block if it is not aligned

@@ -10,6 +10,7 @@
 #include "case/initial_velocity.hpp"
 #include "case/size_limits.hpp"
 #include "core/error.hpp"
+#include "operators/free_surface.hpp"
 #include "schemes/registry.hpp"
 
 namespace rktsph {
@@ -150,6 +151,28 @@ StaggeredModel<Dim>::StaggeredModel(CaseSetup<Dim> case_setup, exec::Threads thr
   Relation<Dim> relation;
   relation.build(constrained_positions, stress_points.position, difference_gradient_relation_options(kernel), policy);
   constrained_gradient = build_difference_gradient<Dim>(relation, constrained_positions, stress_points, kernel);
+
+  // Faces of polygons normal to no axis (method-notes §3.9): traction-free by rotation to their
+  // geometric normal, which step 2 sees as V2 sees its detected surface (surface rows).
+  if (!constraints.rotated().empty()) {
+    if (setup.version == "v2") {
+      throw InputError(fmt::format(
+          "{}: a polygon with edges normal to no axis needs solver.free_surface = \"detect\" in V2 (its "
+          "geometric normals hold in the initial configuration only)",
+          setup.file));
+    }
+    const std::vector<Index>& which = constraints.rotated();
+    surface.row.assign(static_cast<std::size_t>(nodes.size()), -1);
+    for (std::size_t k = 0; k < which.size(); ++k) surface.row[static_cast<std::size_t>(which[k])] = static_cast<Index>(k);
+    surface.normal = constraints.rotated_normals();
+    surface.corner = constraints.rotated_corners();
+    surface.gradient = build_difference_gradient<Dim>(nodes.position, which, stress_points, kernel);
+    const auto& tractions = constraints.rotated_tractions();
+    if (std::any_of(tractions.begin(), tractions.end(), [](const Vec<Dim>& t) { return t.squaredNorm() > 0.0; })) {
+      surface.traction = tractions;
+      surface.traction_function = constraints.rotated_functions();
+    }
+  }
 }
 
 template <int Dim>
@@ -173,6 +196,31 @@ void StaggeredModel<Dim>::apply_constraints(double t) {
         s(i, c.component - Dim) = value;
       }
     }
+  }
+  const std::vector<Index>& rotated = constraints.rotated();
+  for (std::size_t k = 0; k < rotated.size(); ++k) {
+    double* sigma = s[rotated[k]];
+    make_surface_traction_free<Dim>(constraints.rotated_normals()[k], constraints.rotated_corners()[k] != 0, sigma);
+    if (!surface.traction.empty()) add_surface_traction(k, t, sigma);
+  }
+}
+
+template <int Dim>
+void StaggeredModel<Dim>::add_surface_traction(std::size_t row, double t, double* sigma) const {
+  if constexpr (Dim == 2) {
+    // method-notes eq. (3.7.2) with sigma_nn = t_n, sigma_nt = t_t and sigma_tt = 0: the part of
+    // the stress that the condition prescribes (added to the traction-free part).
+    const Vec<Dim>& n = surface.normal[row];
+    const double f = function_value(surface.traction_function[row], t);
+    const double snn = f * surface.traction[row][0], snt = f * surface.traction[row][1];
+    const double c = n[0], sn = n[1];
+    sigma[stress_slot<Dim>(0, 0)] += c * c * snn - 2.0 * sn * c * snt;
+    sigma[stress_slot<Dim>(1, 1)] += sn * sn * snn + 2.0 * sn * c * snt;
+    sigma[stress_slot<Dim>(0, 1)] += sn * c * snn + (c * c - sn * sn) * snt;
+  } else {
+    (void)row;
+    (void)t;
+    (void)sigma;
   }
 }
 
@@ -199,6 +247,17 @@ double StaggeredModel<Dim>::boundary_power() const {
           const double sk =
               s(i, stress_slot<Dim>(k, d)) - (pore_pressure_ != nullptr && k == d ? pore_pressure_[i] : 0.0);
           power += area * sk * normal * v(i, k);
+        }
+      }
+    }
+    if (boundary.has_geometry()) {
+      // Faces normal to no axis (polygons): A (sigma . n) . v with the sum of A n over them.
+      const Vec<Dim>& a = boundary.inclined[b];
+      for (int k = 0; k < Dim; ++k) {
+        for (int d = 0; d < Dim; ++d) {
+          const double sk =
+              s(i, stress_slot<Dim>(k, d)) - (pore_pressure_ != nullptr && k == d ? pore_pressure_[i] : 0.0);
+          power += sk * a[d] * v(i, k);
         }
       }
     }

@@ -87,6 +87,10 @@ class StaggeredModel {
     std::vector<Vec<Dim>> normal;
     std::vector<std::uint8_t> corner;  // 1: two faces meet there (method-notes §3.6)
     DifferenceGradient<Dim> gradient;
+    /// Polygon edges with a prescribed traction (V1, method-notes §3.9): per row (normal,
+    /// tangential) in Pa and its time function; empty where every row is traction-free.
+    std::vector<Vec<Dim>> traction;
+    std::vector<int> traction_function;
   } surface;
   SourceRuns node_sources, stress_point_sources;
 
@@ -104,6 +108,9 @@ class StaggeredModel {
   }
   /// Overwrite the prescribed components with their values at time t.
   void apply_constraints(double t);
+  /// Add to the traction-free stress `sigma` of surface row `row` its prescribed traction at
+  /// time t (polygon edges with a `traction`, method-notes §3.9).
+  void add_surface_traction(std::size_t row, double t, double* sigma) const;
   /// Power of the surface tractions on the body, W (per unit thickness in 2D): the sum over
   /// face nodes of A (sigma . n) . v, with the total stress.
   double boundary_power() const;

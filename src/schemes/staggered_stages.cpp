@@ -317,6 +317,16 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
           }
           if (!m_.surface.row.empty() && m_.surface.row[iu] >= 0) {
             surface_stress_gradient<Dim>(m_.surface, m_.surface.row[iu], sp_s, grad_s);
+            if (!m_.surface.traction.empty()) {
+              // A prescribed traction (polygon edges, method-notes §3.9): the difference form
+              // with fhat = the stress it prescribes, as fix (a) of §0.3 item 1.
+              const auto srow = static_cast<std::size_t>(m_.surface.row[iu]);
+              double prescribed[NS] = {};
+              m_.add_surface_traction(srow, t_half, prescribed);
+              for (int d = 0; d < Dim; ++d) {
+                for (int k = 0; k < NS; ++k) grad_s[d][k] -= m_.surface.gradient.weight_sum[srow][d] * prescribed[k];
+              }
+            }
           }
           const int mat = nodes.material[iu];
           double dv[Dim], dsig[NS];
