@@ -199,6 +199,28 @@ void Section::require(bool condition, std::string_view key, std::string_view mes
   if (!condition) fail(key, message);
 }
 
+std::vector<std::vector<double>> Section::number_rows(std::string_view key) const {
+  const toml::node& n = required(key);
+  const toml::array* arr = n.as_array();
+  if (arr == nullptr) fail(key, fmt::format("must be an array of arrays of numbers, got {}", type_name(n)));
+  std::vector<std::vector<double>> out;
+  for (const toml::node& row : *arr) {
+    const toml::array* items = row.as_array();
+    if (items == nullptr)
+      fail(key, fmt::format("must be an array of arrays of numbers, but an element is {}", type_name(row)));
+    std::vector<double> values;
+    for (const toml::node& item : *items) {
+      const std::optional<double> value = number_value(item);
+      if (!value) fail(key, fmt::format("must hold arrays of numbers, but an element is {}", type_name(item)));
+      if (!std::isfinite(*value)) fail(key, "must hold finite numbers");
+      if (!(std::abs(*value) <= kMaxMagnitude)) fail(key, magnitude_message(*value));
+      values.push_back(*value);
+    }
+    out.push_back(std::move(values));
+  }
+  return out;
+}
+
 Section Section::table(std::string_view key) const {
   const toml::node& n = required(key);
   const toml::table* t = n.as_table();

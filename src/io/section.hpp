@@ -45,6 +45,8 @@ class Section {
   bool boolean(std::string_view key, bool fallback) const;
   std::vector<double> numbers(std::string_view key) const;
   std::vector<std::string> strings(std::string_view key) const;
+  /// An array of arrays of numbers, e.g. the points [[x, y], ...] of a polyline.
+  std::vector<std::vector<double>> number_rows(std::string_view key) const;
 
   /// Value checks: fail with a message naming the key when the condition does not hold.
   double positive(std::string_view key) const;
