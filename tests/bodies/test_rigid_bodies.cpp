@@ -367,3 +367,91 @@ TEST(RigidBodies, RunWritesBodiesCsvAndSummary) {
 
 }  // namespace
 }  // namespace rktsph
+
+namespace rktsph {
+namespace {
+
+// Coulomb at the scale of a run: an elastic block pressed onto a Coulomb base by a rough plate
+// pushed down with a force P, then dragged sideways by the plate. The base holds the block
+// until the shear reaches mu P + a W, then the block slides and the plate's horizontal
+// reaction stays at that limit. The block is low (H = W/5) so that the overturning moment of the
+// drag, mu P H, keeps the base in compression (eccentricity mu H = W/17 < W/6).
+//
+// NOT MET, disabled (docs/VALIDATION.md, "Rigid bodies"): the base starts to slide at the limit
+// (base shear 3.44 kN/m against mu P + a W = 3.5 kN/m at t = 0.21 s), but then the base's shear
+// reaction departs from the plate's, base nodes separate from one end (contact width 1 -> 0.5 m
+// by t = 0.26 s) and the run grows without bound by t = 0.38 s. With the adhesion raised so that
+// the base sticks (a = 50 kPa) the base shear reaction still grows past the plate's (24.2 against
+// 10.8 kN/m at t = 0.28 s) and the run diverges: a block sheared between a moving rough plate and
+// a sticking base is not yet stable. The cause is not found; the contact-law switch itself is
+// checked on small configurations in test_contact.cpp.
+TEST(RigidBodies, DISABLED_BlockDraggedOverACoulombBaseSlidesAtTheFrictionLimit) {
+  const test::ThreadCount threads(1);
+  const double load = 1.0e4, mu = 0.3, adhesion = 500.0;  // N/m, -, Pa
+  CaseBuilder<2> b("block dragged over a Coulomb base");
+  b.spacing(0.05)
+      .block(Vec<2>(0.0, 0.0), Vec<2>(1.0, 0.2))
+      .elastic(kE, kNu, kRho)
+      .scheme("v2")
+      .free_surface(true)
+      .time(0.4, 0.5);
+  TimeFunction press = TimeFunction::ramp(0.05);
+  TimeFunction drag = TimeFunction::ramp(0.05, 0.1);  // from t = 0.1 s
+  b.function("press", press).function("drag", drag);
+  CaseSetup<2> c = b.build();
+  BodySpec base = plane_body("base", Vec<2>(0.0, 0.0), Vec<2>(0.0, 1.0), ContactLaw::coulomb);
+  base.friction = mu;
+  base.adhesion = adhesion;
+  c.bodies.push_back(base);
+  BodySpec plate;
+  plate.name = "plate";
+  plate.where = "test";
+  plate.shape = BodyShape::segment;
+  plate.points = {Vec<2>(1.0, 0.2), Vec<2>(0.0, 0.2)};  // soil below
+  plate.law = ContactLaw::rough;
+  plate.velocity = {0.005, 0.0};
+  plate.velocity_function = {function_named(c, "drag"), -1};
+  plate.force_driven = {false, true};
+  plate.force = {0.0, -load};
+  plate.force_function = {-1, function_named(c, "press")};
+  plate.mass = 200.0;
+  c.bodies.push_back(plate);
+  Simulation<2> sim(std::move(c));
+  double shear = 0.0, pressure = 0.0, plate_load = 0.0, base_slip = 0.0;
+  long samples = 0;
+  std::vector<Vec<2>> start;
+  while (sim.time() < 0.4 - 1e-12) {
+    sim.step();
+    if (sim.time() >= 0.2 && start.empty()) start = sim.nodes().position;
+    if (sim.time() < 0.25) continue;
+    const auto& st = contact_of(sim).state();
+    shear += st[1].force[0];
+    pressure -= st[0].force[1];
+    plate_load += st[1].force[1];
+    ++samples;
+  }
+  shear /= static_cast<double>(samples);
+  pressure /= static_cast<double>(samples);
+  plate_load /= static_cast<double>(samples);
+  // The block's base moved with the plate: it slides.
+  const auto& x = sim.nodes().position;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    if (start[i][1] < 1e-9) base_slip = std::max(base_slip, x[i][0] - start[i][0]);
+  }
+  const RigidContact& contact = contact_of(sim);
+  const double width = contact.state()[0].width;
+  const double limit = mu * pressure + adhesion * width;
+  const double error = std::abs(-shear - limit) / limit;
+  std::fprintf(stderr,
+               "Coulomb drag: plate shear %.6g N/m, limit mu P + a W = %.6g (base P = %.6g, plate %.6g, W = %.4g), "
+               "error %.2e, base slip over 0.2 s %.4g m\n",
+               -shear, limit, pressure, plate_load, width, error, base_slip);
+  EXPECT_NEAR(pressure, load, 0.02 * load);
+  EXPECT_NEAR(plate_load, load, 0.02 * load);
+  EXPECT_NEAR(width, 1.0, 1e-6);
+  EXPECT_LT(error, 0.03);
+  EXPECT_GT(base_slip, 0.5 * 0.005 * 0.2);
+}
+
+}  // namespace
+}  // namespace rktsph
