@@ -327,7 +327,8 @@ void RigidContact::measure(const std::vector<Vec<2>>& x, ConstFieldView<double, 
 int RigidContact::faces_body(const Vec<2>& x, const Vec<2>& n_out, double range) const {
   for (std::size_t b = 0; b < bodies_.size(); ++b) {
     const BodyGap gap = bodies_[b].gap(x, state_[b].offset, depth_);
-    if (gap.within && gap.g <= range && -n_out.dot(gap.normal) > kCos45) return static_cast<int>(b);
+    // A node on the body's surface (a contact released under tension) is a true free surface.
+    if (gap.within && gap.g > keep_ && gap.g <= range && -n_out.dot(gap.normal) > kCos45) return static_cast<int>(b);
   }
   return -1;
 }

@@ -75,9 +75,14 @@ class RigidContact {
   /// Contact slots of node i: body index (or -1), normal, Coulomb slip sign (0: stick).
   int contact_body(std::size_t i, int k) const { return body_[kMaxContacts * i + static_cast<std::size_t>(k)]; }
   std::int8_t slip(std::size_t i, int k) const { return slip_[kMaxContacts * i + static_cast<std::size_t>(k)]; }
+  const Vec<2>& contact_normal(std::size_t i, int k) const {
+    return normal_[kMaxContacts * i + static_cast<std::size_t>(k)];
+  }
+  /// Body b's velocity at t^{n+1/2} over the current step (a force-driven axis: V^n until step 2).
+  const Vec<2>& velocity_half(std::size_t b) const { return velocity_half_[b]; }
   /// The body that a free-surface flag at x with outward normal n_out may only be the
-  /// truncation of the support by: x within `range` of it and n_out pointing into it (within
-  /// 45 degrees); -1 if none.
+  /// truncation of the support by: x off its surface (beyond the keep distance) but within
+  /// `range` of it, and n_out pointing into it (within 45 degrees); -1 if none.
   int faces_body(const Vec<2>& x, const Vec<2>& n_out, double range) const;
 
   void save(io::StateArchive& archive, const std::string& prefix) const;

@@ -37,7 +37,7 @@ std::unique_ptr<Scheme> make_v2_scheme(StaggeredModel<Dim>& model) {
   }
   auto& rebuilt = scheme->add(std::move(rebuild));
   if constexpr (Dim == 2) {
-    if (contact) scheme->add(std::make_unique<ContactSelect>(model, contact));
+    if (contact) scheme->add(std::make_unique<ContactSelect>(model, rebuilt, contact));
   }
   if (model.setup.detect_free_surface) {
     surface = &scheme->add(std::make_unique<DetectFreeSurface<Dim>>(model, rebuilt));

@@ -197,6 +197,48 @@ void ContactSelect::run(const StepContext& c) {
   const auto v = std::as_const(m_.nodes).view(m_.fields.velocity);
   const auto s = std::as_const(m_.nodes).view(m_.fields.stress);
   contact_->begin_step(c.t, c.dt, c.damping, m_.nodes.position, v, s);
+  // Step 2's rows for the contact nodes (method-notes §4.5): the constrained velocity
+  // components in their own gradient with the body's velocity at t^{n+1/2}.
+  auto& rows = m_.contact;
+  const std::size_t nn = m_.nodes.position.size();
+  rows.row.assign(nn, -1);
+  rows.normal.clear();
+  rows.full.clear();
+  rows.velocity.clear();
+  nodes_.clear();
+  const auto& touching = contact_->in_contact();
+  for (std::size_t i = 0; i < nn; ++i) {
+    if (touching[i] == 0) continue;
+    Vec<2> normal = Vec<2>::Zero(), velocity = Vec<2>::Zero();
+    int slots = 0;
+    bool full = false;
+    for (int k = 0; k < RigidContact::kMaxContacts; ++k) {
+      const int b = contact_->contact_body(i, k);
+      if (b < 0) continue;
+      const auto bu = static_cast<std::size_t>(b);
+      const ContactLaw law = contact_->bodies()[bu].spec().law;
+      const Vec<2>& n = contact_->contact_normal(i, k);
+      const Vec<2>& vb = contact_->velocity_half(bu);
+      if (slots == 0) {
+        normal = n;
+        velocity = vb;
+      } else {
+        // Two bodies (a corner): both normal components held, the velocity from each body's.
+        velocity = velocity.dot(normal) * normal + (vb - vb.dot(normal) * normal);
+        full = true;
+      }
+      full = full || law == ContactLaw::rough || law == ContactLaw::bonded ||
+             (law == ContactLaw::coulomb && contact_->slip(i, k) == 0);
+      ++slots;
+    }
+    rows.row[i] = static_cast<Index>(nodes_.size());
+    nodes_.push_back(static_cast<Index>(i));
+    rows.normal.push_back(normal);
+    rows.full.push_back(full ? 1 : 0);
+    rows.velocity.push_back(velocity);
+  }
+  build_difference_gradient_rows<2>(rebuild_.stress_points_of_nodes(), m_.nodes.position, nodes_, m_.stress_points,
+                                    m_.kernel, rows.gradient);
 }
 
 void ContactEnforce::run(const StepContext& c) {

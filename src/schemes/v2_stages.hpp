@@ -136,14 +136,16 @@ class SurfaceTractionFree final : public Stage {
 /// velocities over the step and the contact set from the state at t^n.
 class ContactSelect final : public Stage {
  public:
-  ContactSelect(StaggeredModel<2>& model, std::shared_ptr<RigidContact> contact)
-      : m_(model), contact_(std::move(contact)) {}
+  ContactSelect(StaggeredModel<2>& model, const RebuildOperators<2>& rebuild, std::shared_ptr<RigidContact> contact)
+      : m_(model), rebuild_(rebuild), contact_(std::move(contact)) {}
   std::string_view name() const override { return "contact_select"; }
   void run(const StepContext& context) override;
 
  private:
   StaggeredModel<2>& m_;
+  const RebuildOperators<2>& rebuild_;
   std::shared_ptr<RigidContact> contact_;
+  std::vector<Index> nodes_;  // the contact nodes of the step
 };
 
 /// Rigid bodies after step 2 and the prescribed components: the contact constraints at
