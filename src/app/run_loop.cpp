@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <iostream>
 #include <limits>
+#include <optional>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -25,6 +26,7 @@
 #include "rktsph/version.hpp"
 #include "schemes/pressure_stage.hpp"
 #include "schemes/simulation.hpp"
+#include "schemes/v2_stages.hpp"
 
 namespace rktsph {
 
@@ -189,6 +191,19 @@ int run_loop(const LoopInput& in) {
   // Output streams: a fresh run starts them; a resumed one cuts them back to the checkpoint.
   io::RowFile probe_csv((out / "probes.csv").string(), resuming ? in.checkpoint->integer("run/probes_bytes") : -1);
   io::RowFile energy_csv((out / "energy.csv").string(), resuming ? in.checkpoint->integer("run/energy_bytes") : -1);
+  // bodies.csv (V2 with rigid bodies): one row per body at every output step.
+  const ContactEnforce* bodies = nullptr;
+  for (const auto& stage : solver.scheme().stages()) {
+    if (auto* c = dynamic_cast<const ContactEnforce*>(stage.get())) bodies = c;
+  }
+  std::optional<io::RowFile> bodies_csv;
+  if (bodies != nullptr) {
+    bodies_csv.emplace((out / "bodies.csv").string(), resuming ? in.checkpoint->integer("run/bodies_bytes") : -1);
+    if (!resuming) bodies_csv->append(ContactEnforce::csv_header());
+  }
+  auto record_bodies = [&] {
+    if (bodies_csv) bodies_csv->append(bodies->csv_rows(solver.time()));
+  };
   io::PvdCollection node_pvd((out / "nodes.pvd").string());
   io::PvdCollection elem_pvd((out / "elements.pvd").string());
   if (resuming) {
@@ -239,6 +254,7 @@ int run_loop(const LoopInput& in) {
   auto flush_streams = [&] {
     probe_csv.flush();
     energy_csv.flush();
+    if (bodies_csv) bodies_csv->flush();
   };
   const fs::path checkpoint_file = out / "checkpoint" / "checkpoint.h5";
   auto write_checkpoint = [&](double loop_seconds) {
@@ -262,6 +278,7 @@ int run_loop(const LoopInput& in) {
     a.put("run/checkpoint_interval", checkpoint_every);
     a.put_integer("run/probes_bytes", probe_csv.written());
     a.put_integer("run/energy_bytes", energy_csv.written());
+    if (bodies_csv) a.put_integer("run/bodies_bytes", bodies_csv->written());
     save_entries(a, "run/node_frames", node_pvd.entries());
     save_entries(a, "run/stress_point_frames", elem_pvd.entries());
     fs::create_directories(out / "checkpoint");
@@ -405,6 +422,7 @@ int run_loop(const LoopInput& in) {
     if (!resuming) {
       record_probes();
       record_energy();
+      record_bodies();
       write_frame();
       flush_streams();
     }
@@ -437,6 +455,7 @@ int run_loop(const LoopInput& in) {
         ++loop.next_time_index;
       }
       if (output) {
+        record_bodies();
         write_frame();
         flush_streams();  // the tables are on disk at every output step
       }

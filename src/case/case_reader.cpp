@@ -11,6 +11,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include "case/body_reader.hpp"
 #include "case/case_reader.hpp"
 #include "case/case_reader_sections.hpp"
 #include "case/polygon_reader.hpp"
@@ -309,6 +310,37 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     else
       s->fail("source_coupling", fmt::format("unknown source coupling '{}' (known: additive, frozen_flux)", coupling));
     s->finish();
+  }
+
+  // ---- rigid bodies (V2 in 2D, with the detected free surface: a lattice face keeps its
+  // traction-free condition in global axes, which a contact would have to override)
+  {
+    const std::vector<io::Section> bodies = root.tables("body");
+    if (!bodies.empty()) {
+      if constexpr (Dim == 2) {
+        if (c.version != "v2") {
+          root.fail("body", fmt::format("rigid bodies need solver.version = \"v2\" (this case has \"{}\"); the "
+                                        "small-deformation schemes take [[boundary]] entries",
+                                        c.version));
+        }
+        if (!c.detect_free_surface) {
+          root.fail("body",
+                    "rigid bodies need solver.free_surface = \"detect\": on the lattice's faces the "
+                    "traction-free condition would cancel the contact pressure");
+        }
+        for (std::size_t k = 0; k < bodies.size(); ++k) {
+          c.bodies.push_back(case_reading::read_body(bodies[k], c, k));
+          for (std::size_t j = 0; j < k; ++j) {
+            if (c.bodies[j].name == c.bodies[k].name) {
+              bodies[k].fail("name",
+                             fmt::format("a second body named '{}' (names label bodies.csv)", c.bodies[k].name));
+            }
+          }
+        }
+      } else {
+        root.fail("body", "rigid bodies are 2D only");
+      }
+    }
   }
 
   // Particles from files without their faces lie on no face: nothing would make their surface

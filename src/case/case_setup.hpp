@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "bc/time_function.hpp"
+#include "bodies/rigid_body.hpp"
 #include "core/types.hpp"
 #include "materials/material.hpp"
 #include "particles/lattice.hpp"
@@ -188,6 +189,8 @@ struct CaseSetup {
   double damping_ratio_from = 0.0;
   double damping_ratio_hold = 0.0;  // s the kinetic energy must stay below the ratio before the switch
   std::vector<BoundarySpec<Dim>> boundaries;
+  /// [[body]]: rigid bodies in contact with the nodes (V2 in 2D; bodies/contact.hpp).
+  std::vector<BodySpec> bodies;
 
   // initial state
   InitialStressKind initial_stress = InitialStressKind::zero;

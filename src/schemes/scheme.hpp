@@ -50,6 +50,9 @@ class Scheme {
   /// Energy stored per node besides the elastic strain energy (J/m^Dim; V3: the fluid's
   /// p^2/(2 Q*)), added to the strain-energy density of node i. Empty: none.
   std::function<double(Index)> stored_energy_density;
+  /// Power of loads outside the particle sets on the body, W (V2: the rigid bodies' contact
+  /// tractions), added to the boundary power of the energy account. Empty: none.
+  std::function<double()> extra_power;
   /// A hint appended to the growth guard's message (V3: the undrained Courant limit). Empty: none.
   std::function<std::string()> instability_hint;
 

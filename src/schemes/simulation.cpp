@@ -19,7 +19,12 @@ Simulation<Dim>::Simulation(CaseSetup<Dim> setup, exec::Threads policy)
       nodes_made_(model_->nodes.fingerprint()),
       stress_points_made_(model_->stress_points.fingerprint()) {
   model_->set_initial_state();
-  clock_.start(energy().strain, model_->boundary_power(), balance_sums());
+  clock_.start(energy().strain, external_power(), balance_sums());
+}
+
+template <int Dim>
+double Simulation<Dim>::external_power() {
+  return model_->boundary_power() + (scheme_->extra_power ? scheme_->extra_power() : 0.0);
 }
 
 template <int Dim>
@@ -72,8 +77,7 @@ void Simulation<Dim>::step() {
         "material parameters",
         clock_.steps() + 1, t + clock_.dt(), bad, fmt::join(x.data(), x.data() + Dim, ", "), clock_.courant()));
   }
-  clock_.end_step(sums, model_->boundary_power(),
-                  scheme_->instability_hint ? scheme_->instability_hint() : std::string());
+  clock_.end_step(sums, external_power(), scheme_->instability_hint ? scheme_->instability_hint() : std::string());
 }
 
 template <int Dim>

@@ -104,6 +104,8 @@ class Simulation {
 
  private:
   StepSums<Dim> balance_sums();
+  /// The power of the loads: the boundary tractions and the scheme's extra power (bodies).
+  double external_power();
 
   std::unique_ptr<StaggeredModel<Dim>> model_;
   std::unique_ptr<Scheme> scheme_;

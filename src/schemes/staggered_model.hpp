@@ -92,6 +92,18 @@ class StaggeredModel {
     std::vector<Vec<Dim>> traction;
     std::vector<int> traction_function;
   } surface;
+  /// V2's contact nodes with rigid bodies (schemes/v2_stages.hpp, method-notes §4.5), empty
+  /// otherwise: each node's row or -1, and per row the body's normal, whether the tangential
+  /// velocity is held too (stick, or two bodies), the body's velocity at t^{n+1/2} and the
+  /// difference gradient from the stress points, with which step 2 takes the constrained
+  /// velocity components in their own gradient (fix (a) of §0.3 item 1).
+  struct ContactRows {
+    std::vector<Index> row;
+    std::vector<Vec<Dim>> normal;
+    std::vector<std::uint8_t> full;
+    std::vector<Vec<Dim>> velocity;
+    DifferenceGradient<Dim> gradient;
+  } contact;
   SourceRuns node_sources, stress_point_sources;
 
   double dx() const { return setup.dx; }

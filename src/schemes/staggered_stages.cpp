@@ -236,6 +236,41 @@ void surface_stress_gradient(const typename StaggeredModel<Dim>::SurfaceRows& su
   }
 }
 
+// The velocity gradient at a node in contact with a rigid body (V2, method-notes §4.5): the
+// components the contact prescribes enter their own gradient through the difference form with
+// fhat = the body's velocity (fix (a) of §0.3 item 1), the others keep the corrected gradient.
+// Held in full (stick, two bodies): every component; else the normal one, v.n.
+template <int Dim>
+void contact_velocity_gradient(const typename StaggeredModel<Dim>::ContactRows& contact, Index row,
+                               ConstFieldView<double, Dim> sp_v, double (&grad_v)[Dim][Dim]) {
+  const DifferenceGradient<Dim>& g = contact.gradient;
+  const auto r = static_cast<std::size_t>(row);
+  const Vec<Dim>& fhat = contact.velocity[r];
+  double diff[Dim][Dim] = {};
+  for (Index k = g.row_start[r]; k < g.row_start[r + 1]; ++k) {
+    const double* v = sp_v[g.source[static_cast<std::size_t>(k)]];
+    const Vec<Dim>& w = g.weight[static_cast<std::size_t>(k)];
+    for (int d = 0; d < Dim; ++d) {
+      for (int q = 0; q < Dim; ++q) diff[d][q] += w[d] * v[q];
+    }
+  }
+  for (int d = 0; d < Dim; ++d) {
+    for (int q = 0; q < Dim; ++q) diff[d][q] -= g.weight_sum[r][d] * fhat[q];
+  }
+  if (contact.full[r] != 0) {
+    for (int d = 0; d < Dim; ++d) {
+      for (int q = 0; q < Dim; ++q) grad_v[d][q] = diff[d][q];
+    }
+    return;
+  }
+  const Vec<Dim>& n = contact.normal[r];
+  for (int d = 0; d < Dim; ++d) {
+    double change = 0.0;  // n . (diff - corrected) along axis d
+    for (int q = 0; q < Dim; ++q) change += n[q] * (diff[d][q] - grad_v[d][q]);
+    for (int q = 0; q < Dim; ++q) grad_v[d][q] += n[q] * change;
+  }
+}
+
 }  // namespace
 
 template <int Dim, class Motion, class Velocity>
@@ -327,6 +362,9 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
                 for (int k = 0; k < NS; ++k) grad_s[d][k] -= m_.surface.gradient.weight_sum[srow][d] * prescribed[k];
               }
             }
+          }
+          if (!m_.contact.row.empty() && m_.contact.row[iu] >= 0) {
+            contact_velocity_gradient<Dim>(m_.contact, m_.contact.row[iu], sp_v, grad_v);
           }
           const int mat = nodes.material[iu];
           double dv[Dim], dsig[NS];

@@ -9,8 +9,11 @@
 //   3. prescribed components at t^{n+1} (and V1's velocity filter with the Taylor-Galerkin
 //      update only: the simple scheme has no nodal mode to filter); the free surface made
 //      traction-free again on the stress at t^{n+1}.
+// With rigid bodies (2D, method-notes §4.5): the contact set at t^n after step 0 (its nodes are
+// never flagged as free surface), the contact constraints, projections and reactions after 3.
 #include <chrono>
 #include <memory>
+#include <utility>
 
 #include "schemes/registry.hpp"
 #include "schemes/staggered_stages.hpp"
@@ -24,13 +27,21 @@ std::unique_ptr<Scheme> make_v2_scheme(StaggeredModel<Dim>& model) {
   auto sources = std::make_shared<ViscoplasticSources<Dim>>(model);
   auto rebuild = std::make_unique<RebuildOperators<Dim>>(model);
   DetectFreeSurface<Dim>* surface = nullptr;
+  std::shared_ptr<RigidContact> contact;
+  if constexpr (Dim == 2) {
+    if (!model.setup.bodies.empty()) {
+      contact = std::make_shared<RigidContact>(model.setup.bodies, model.nodes.position.size(),
+                                               model.stress_points.position.size(), model.dx(),
+                                               [&model](int f, double t) { return model.function_value(f, t); });
+    }
+  }
+  auto& rebuilt = scheme->add(std::move(rebuild));
+  if constexpr (Dim == 2) {
+    if (contact) scheme->add(std::make_unique<ContactSelect>(model, rebuilt, contact));
+  }
   if (model.setup.detect_free_surface) {
-    auto detect = std::make_unique<DetectFreeSurface<Dim>>(model, *rebuild);
-    surface = detect.get();
-    scheme->add(std::move(rebuild));
-    scheme->add(std::move(detect));
-  } else {
-    scheme->add(std::move(rebuild));
+    surface = &scheme->add(std::make_unique<DetectFreeSurface<Dim>>(model, rebuilt));
+    if constexpr (Dim == 2) surface->set_contact(contact.get());
   }
   scheme->add(std::make_unique<StressPointHalfStep<Dim, NoPressureGradient, MovingParticles>>(model, sources));
   if (model.setup.simple_velocity) {
@@ -42,6 +53,19 @@ std::unique_ptr<Scheme> make_v2_scheme(StaggeredModel<Dim>& model) {
     if (model.setup.filter) {
       scheme->add(std::make_unique<VelocityFilter<Dim>>(model, model.setup.filter_strength));
       scheme->add(std::make_unique<ApplyConstraints<Dim>>(model));
+    }
+  }
+  if constexpr (Dim == 2) {
+    if (contact) {
+      scheme->add(std::make_unique<ContactEnforce>(model, contact));
+      // The energy account (method-notes §4.5): the power of the contact tractions on the soil.
+      scheme->extra_power = [contact, &model] {
+        if (!contact->selected()) {
+          contact->select_now(0.0, model.nodes.position, std::as_const(model.nodes).view(model.fields.velocity),
+                              std::as_const(model.nodes).view(model.fields.stress));
+        }
+        return contact->power();
+      };
     }
   }
   if (surface != nullptr) scheme->add(std::make_unique<SurfaceTractionFree<Dim>>(*surface));

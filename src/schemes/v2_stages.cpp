@@ -2,6 +2,10 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <utility>
+
+#include <fmt/format.h>
 
 #include "io/state_archive.hpp"
 #include "operators/corrected_operator.hpp"
@@ -93,8 +97,9 @@ DetectFreeSurface<Dim>::DetectFreeSurface(StaggeredModel<Dim>& model, const Rebu
   normal_field_ =
       m_.nodes.template add_field<double, Dim>("normal", normal_names, kFieldOutput, Dim, FieldKind::vector);
   const auto nn = static_cast<std::size_t>(m_.nodes.size());
-  excluded_.assign(nn, 0);
-  for (const Index i : m_.constraints.constrained()) excluded_[static_cast<std::size_t>(i)] = 1;
+  fixed_excluded_.assign(nn, 0);
+  for (const Index i : m_.constraints.constrained()) fixed_excluded_[static_cast<std::size_t>(i)] = 1;
+  excluded_ = fixed_excluded_;
   previous_.reserve(nn);
   flags_.reserve(nn);
   normals_.reserve(nn);
@@ -110,8 +115,41 @@ void DetectFreeSurface<Dim>::run(const StepContext&) {
   previous_.resize(detections_ > 0 ? nn : 0);
   for (std::size_t i = 0; i < previous_.size(); ++i) previous_[i] = flag(i, 0) != 0.0 ? 1 : 0;
   ++detections_;
+  if constexpr (Dim == 2) {
+    if (contact_ != nullptr) {
+      const auto& touching = contact_->in_contact();
+      for (std::size_t i = 0; i < nn; ++i) excluded_[i] = fixed_excluded_[i] | touching[i];
+    }
+  }
   detect_free_surface<Dim>(m_.nodes, rebuild_.node_neighbours(), m_.kernel, FreeSurfaceOptions{}, previous_, excluded_,
                            flags_, normals_, m_.policy, &corners_, &scratch_);
+  unflagged_by_bodies_ = 0;
+  if constexpr (Dim == 2) {
+    // Next to a body the support is cut by it, not by a free surface: a flag whose normal
+    // points into a body within the support, at a node with a neighbour in contact with that
+    // body (the soil reaches the body there), is that cut (method-notes §4.5, "Free surface").
+    // A face facing a body across a gap has no such neighbour and stays flagged.
+    if (contact_ != nullptr) {
+      const double range = m_.kernel.support_radius();
+      const auto& neighbours = rebuild_.node_neighbours();
+      for (std::size_t i = 0; i < nn; ++i) {
+        if (flags_[i] == 0) continue;
+        const int body = contact_->faces_body(m_.nodes.position[i], normals_[i], range);
+        if (body < 0) continue;
+        bool touches = false;
+        for (const Index j : neighbours.row(static_cast<Index>(i))) {
+          const auto ju = static_cast<std::size_t>(j);
+          if ((m_.nodes.position[ju] - m_.nodes.position[i]).norm() > range) continue;
+          for (int k = 0; k < RigidContact::kMaxContacts; ++k)
+            touches = touches || contact_->contact_body(ju, k) == body;
+        }
+        if (!touches) continue;
+        flags_[i] = 0;
+        normals_[i].setZero();
+        ++unflagged_by_bodies_;
+      }
+    }
+  }
   surface_.clear();
   for (std::size_t i = 0; i < nn; ++i) {
     flag(i, 0) = flags_[i];
@@ -153,6 +191,102 @@ void DetectFreeSurface<Dim>::reapply_traction_free() {
     const auto iu = static_cast<std::size_t>(i);
     rktsph::make_surface_traction_free<Dim>(normals_[iu], corners_[iu] != 0, stress[i]);
   }
+}
+
+void ContactSelect::run(const StepContext& c) {
+  const auto v = std::as_const(m_.nodes).view(m_.fields.velocity);
+  const auto s = std::as_const(m_.nodes).view(m_.fields.stress);
+  contact_->begin_step(c.t, c.dt, c.damping, m_.nodes.position, v, s);
+  // Step 2's rows for the contact nodes (method-notes §4.5): the constrained velocity
+  // components in their own gradient with the body's velocity at t^{n+1/2}.
+  auto& rows = m_.contact;
+  const std::size_t nn = m_.nodes.position.size();
+  rows.row.assign(nn, -1);
+  rows.normal.clear();
+  rows.full.clear();
+  rows.velocity.clear();
+  nodes_.clear();
+  const auto& touching = contact_->in_contact();
+  for (std::size_t i = 0; i < nn; ++i) {
+    if (touching[i] == 0) continue;
+    Vec<2> normal = Vec<2>::Zero(), velocity = Vec<2>::Zero();
+    int slots = 0;
+    bool full = false;
+    for (int k = 0; k < RigidContact::kMaxContacts; ++k) {
+      const int b = contact_->contact_body(i, k);
+      if (b < 0) continue;
+      const auto bu = static_cast<std::size_t>(b);
+      const ContactLaw law = contact_->bodies()[bu].spec().law;
+      const Vec<2>& n = contact_->contact_normal(i, k);
+      const Vec<2>& vb = contact_->velocity_half(bu);
+      if (slots == 0) {
+        normal = n;
+        velocity = vb;
+      } else {
+        // Two bodies (a corner): both normal components held, the velocity from each body's.
+        velocity = velocity.dot(normal) * normal + (vb - vb.dot(normal) * normal);
+        full = true;
+      }
+      full = full || law == ContactLaw::rough || law == ContactLaw::bonded ||
+             (law == ContactLaw::coulomb && contact_->slip(i, k) == 0);
+      ++slots;
+    }
+    rows.row[i] = static_cast<Index>(nodes_.size());
+    nodes_.push_back(static_cast<Index>(i));
+    rows.normal.push_back(normal);
+    rows.full.push_back(full ? 1 : 0);
+    rows.velocity.push_back(velocity);
+  }
+  build_difference_gradient_rows<2>(rebuild_.stress_points_of_nodes(), m_.nodes.position, nodes_, m_.stress_points,
+                                    m_.kernel, rows.gradient);
+}
+
+void ContactEnforce::run(const StepContext& c) {
+  contact_->end_step(c.dt, m_.nodes.position, m_.nodes.view(m_.fields.velocity), m_.nodes.view(m_.fields.stress),
+                     m_.nodes.view(m_.fields.displacement), m_.stress_points.position);
+}
+
+std::size_t ContactEnforce::scratch_bytes() const {
+  const std::size_t nn = m_.nodes.position.size();
+  // Per node: two slots of body, normal and slip (and their last step), the flag, x^n, the sort row.
+  return nn * (RigidContact::kMaxContacts * (2 * sizeof(int) + sizeof(Vec<2>) + 2) + 1 + sizeof(Vec<2>) +
+               sizeof(std::pair<double, std::size_t>));
+}
+
+std::vector<std::pair<std::string, double>> ContactEnforce::report() const {
+  std::vector<std::pair<std::string, double>> out;
+  for (std::size_t b = 0; b < contact_->bodies().size(); ++b) {
+    const std::string& name = contact_->bodies()[b].spec().name;
+    const BodyState& st = contact_->state()[b];
+    out.emplace_back(name + ".Fx", st.force[0]);
+    out.emplace_back(name + ".Fy", st.force[1]);
+    out.emplace_back(name + ".contact_width", st.width);
+    out.emplace_back(name + ".contact_nodes", static_cast<double>(st.contact_nodes));
+    out.emplace_back(name + ".node_projections", static_cast<double>(st.node_projections));
+    out.emplace_back(name + ".stress_point_projections", static_cast<double>(st.stress_point_projections));
+    out.emplace_back(name + ".displacement_x", st.offset[0]);
+    out.emplace_back(name + ".displacement_y", st.offset[1]);
+    out.emplace_back(name + ".work", st.work);
+  }
+  return out;
+}
+
+std::string ContactEnforce::csv_header() {
+  return "t,body,ux,uy,vx,vy,Fx,Fy,contact_width,contact_nodes,node_projections,stress_point_projections,work,"
+         "min_gap\n";
+}
+
+std::string ContactEnforce::csv_rows(double t) const {
+  std::string rows;
+  for (std::size_t b = 0; b < contact_->bodies().size(); ++b) {
+    const BodyState& st = contact_->state()[b];
+    const double gap = std::isfinite(st.min_gap) ? st.min_gap : 0.0;
+    rows += fmt::format("{:.10g},{},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{},{},{},{:.10g},{:.10g}\n",
+                        t, contact_->bodies()[b].spec().name, st.offset[0], st.offset[1], st.velocity[0],
+                        st.velocity[1], st.force[0], st.force[1], st.width, st.contact_nodes, st.node_projections,
+                        st.stress_point_projections, st.work, gap);
+  }
+  return rows;
 }
 
 template class RebuildOperators<1>;

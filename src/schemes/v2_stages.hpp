@@ -2,9 +2,12 @@
 // The stages V2 adds to V1's (method-notes §5.2): the neighbour relations and corrected
 // operators rebuilt from the current positions at the start of every step.
 #include <cstdint>
+#include <memory>
+#include <string>
 #include <string_view>
 #include <vector>
 
+#include "bodies/contact.hpp"
 #include "neighbours/relation.hpp"
 #include "operators/free_surface.hpp"
 #include "schemes/stage.hpp"
@@ -90,8 +93,13 @@ class DetectFreeSurface final : public Stage {
   void load(const io::StateArchive& archive, const std::string& prefix) override;
   /// sigma.n = 0 at the flagged nodes with the normals of the last detection.
   void reapply_traction_free();
+  /// Rigid bodies (2D): their contact nodes are never flagged, and a node whose flag only
+  /// reflects the support cut by a body (its normal pointing into the body) is unflagged.
+  void set_contact(const RigidContact* contact) { contact_ = contact; }
   std::vector<std::pair<std::string, double>> report() const override {
-    return {{"surface_nodes_last_step", static_cast<double>(surface_nodes_)}, {"detection_seconds", seconds_}};
+    return {{"surface_nodes_last_step", static_cast<double>(surface_nodes_)},
+            {"detection_seconds", seconds_},
+            {"unflagged_next_to_bodies_last_step", static_cast<double>(unflagged_by_bodies_)}};
   }
 
  private:
@@ -99,7 +107,9 @@ class DetectFreeSurface final : public Stage {
   const RebuildOperators<Dim>& rebuild_;
   Field<double, 1> flag_field_;
   Field<double, Dim> normal_field_;
-  std::vector<std::uint8_t> previous_, flags_, excluded_, corners_;
+  std::vector<std::uint8_t> previous_, flags_, excluded_, fixed_excluded_, corners_;
+  const RigidContact* contact_ = nullptr;
+  Index unflagged_by_bodies_ = 0;
   FreeSurfaceScratch<Dim> scratch_;
   std::vector<Vec<Dim>> normals_;
   std::vector<Index> surface_;  // the flagged nodes
@@ -120,6 +130,45 @@ class SurfaceTractionFree final : public Stage {
 
  private:
   DetectFreeSurface<Dim>& detect_;
+};
+
+/// Rigid bodies in 2D (method-notes §4.5), before the free surface is detected: the bodies'
+/// velocities over the step and the contact set from the state at t^n.
+class ContactSelect final : public Stage {
+ public:
+  ContactSelect(StaggeredModel<2>& model, const RebuildOperators<2>& rebuild, std::shared_ptr<RigidContact> contact)
+      : m_(model), rebuild_(rebuild), contact_(std::move(contact)) {}
+  std::string_view name() const override { return "contact_select"; }
+  void run(const StepContext& context) override;
+
+ private:
+  StaggeredModel<2>& m_;
+  const RebuildOperators<2>& rebuild_;
+  std::shared_ptr<RigidContact> contact_;
+  std::vector<Index> nodes_;  // the contact nodes of the step
+};
+
+/// Rigid bodies after step 2 and the prescribed components: the contact constraints at
+/// t^{n+1}, the projections and the reactions. Keeps the bodies' state in checkpoints and
+/// writes their rows of bodies.csv.
+class ContactEnforce final : public Stage {
+ public:
+  ContactEnforce(StaggeredModel<2>& model, std::shared_ptr<RigidContact> contact)
+      : m_(model), contact_(std::move(contact)) {}
+  std::string_view name() const override { return "contact_enforce"; }
+  void run(const StepContext& context) override;
+  std::size_t scratch_bytes() const override;
+  void save(io::StateArchive& archive, const std::string& prefix) const override { contact_->save(archive, prefix); }
+  void load(const io::StateArchive& archive, const std::string& prefix) override { contact_->load(archive, prefix); }
+  std::vector<std::pair<std::string, double>> report() const override;
+  const RigidContact& contact() const { return *contact_; }
+  /// bodies.csv (docs/output.md): the header, and one row per body at time t.
+  static std::string csv_header();
+  std::string csv_rows(double t) const;
+
+ private:
+  StaggeredModel<2>& m_;
+  std::shared_ptr<RigidContact> contact_;
 };
 
 }  // namespace rktsph

@@ -1,0 +1,116 @@
+#pragma once
+// The contact of the nodes with rigid bodies (method-notes §4.5), a node-level kinematic
+// constraint in the body's local frame (n into the soil, t = (n_y, -n_x)); no dummy particles,
+// no penalty. Per step:
+//   begin_step (state at t^n): the bodies' velocities over the step (prescribed, or from the
+//     force balance for a force-driven body), and the contact set: nodes within the join
+//     distance of a body that approach it (or rest on it), kept while within the keep distance
+//     and not under tension beyond the adhesion (never released when bonded); at most two
+//     bodies per node;
+//   end_step (state at t^{n+1}, after step 2): the constraints on the contact nodes
+//     (v_n = V.n; tangential by the law, with Coulomb's stick/slip decided explicitly on the
+//     trial stress), the positions and displacements moved with the body, the stress
+//     conditions (smooth: sigma_nt = 0; Coulomb slip: sigma_nt = sgn(dv_t) tau_max), then any
+//     other node or stress point that crossed a body projected back onto it (counted), and the
+//     reaction of each body F = sum_I sigma_I n A_I with the tributary lengths A_I.
+// Every array is sized at construction: the steps allocate nothing.
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "bodies/rigid_body.hpp"
+#include "particles/field.hpp"
+
+namespace rktsph {
+namespace io {
+class StateArchive;
+}
+
+/// What the bodies' state is at the last measure (reaction at the current state).
+struct BodyState {
+  Vec<2> offset = Vec<2>::Zero();    // m, translation from the case's position
+  Vec<2> velocity = Vec<2>::Zero();  // m/s
+  Vec<2> force = Vec<2>::Zero();     // N/m: the reaction of the soil on the body, sum sigma n A
+  double width = 0.0;                // m: the contact width, sum A
+  long contact_nodes = 0;
+  long node_projections = 0;  // nodes that crossed the body and were put back on it (total)
+  long stress_point_projections = 0;
+  double work = 0.0;     // J/m: the work of the reaction on the body, int F.V dt
+  double min_gap = 0.0;  // m: the smallest signed distance of a node before projection (last step)
+};
+
+class RigidContact {
+ public:
+  static constexpr int kMaxContacts = 2;
+  static constexpr int NS = 4;  // 2D stress slots: xx, yy, zz, xy
+  using FunctionValue = std::function<double(int, double)>;
+
+  /// Bodies of a case, for `nodes` nodes and `stress_points` stress points at spacing dx.
+  RigidContact(const std::vector<BodySpec>& specs, std::size_t nodes, std::size_t stress_points, double dx,
+               FunctionValue functions);
+
+  /// The join distance: a node at most this far from a body (as generated on it, or put back
+  /// on it by a projection) may come into contact, m.
+  double join_distance() const { return join_; }
+
+  /// State at t^n: the bodies' velocities over [t, t + dt] and the contact set.
+  void begin_step(double t, double dt, double damping, const std::vector<Vec<2>>& x, ConstFieldView<double, 2> v,
+                  ConstFieldView<double, NS> s);
+  /// State at t^{n+1}: a force-driven body's velocity, the constraints, projections and the
+  /// reaction.
+  void end_step(double dt, std::vector<Vec<2>>& x, FieldView<double, 2> v, FieldView<double, NS> s,
+                FieldView<double, 2> u, std::vector<Vec<2>>& stress_point_x);
+  /// The contact set and the reaction at the current state without advancing (t = 0, output).
+  void select_now(double t, const std::vector<Vec<2>>& x, ConstFieldView<double, 2> v, ConstFieldView<double, NS> s);
+  bool selected() const { return selected_; }
+
+  /// Power of the bodies' tractions on the soil at the last measure, W/m: sum_I (-sigma_I n A_I).v_I.
+  double power() const { return power_; }
+  const std::vector<RigidBody>& bodies() const { return bodies_; }
+  const std::vector<BodyState>& state() const { return state_; }
+  /// 1 at the nodes in contact (excluded from free-surface detection).
+  const std::vector<std::uint8_t>& in_contact() const { return in_contact_; }
+  /// Contact slots of node i: body index (or -1), normal, Coulomb slip sign (0: stick).
+  int contact_body(std::size_t i, int k) const { return body_[kMaxContacts * i + static_cast<std::size_t>(k)]; }
+  std::int8_t slip(std::size_t i, int k) const { return slip_[kMaxContacts * i + static_cast<std::size_t>(k)]; }
+  const Vec<2>& contact_normal(std::size_t i, int k) const {
+    return normal_[kMaxContacts * i + static_cast<std::size_t>(k)];
+  }
+  /// Body b's velocity at t^{n+1/2} over the current step (a force-driven axis: V^n until step 2).
+  const Vec<2>& velocity_half(std::size_t b) const { return velocity_half_[b]; }
+  /// The body that a free-surface flag at x with outward normal n_out may only be the
+  /// truncation of the support by: x off its surface (beyond the keep distance) but within
+  /// `range` of it, and n_out pointing into it (within 45 degrees); -1 if none.
+  int faces_body(const Vec<2>& x, const Vec<2>& n_out, double range) const;
+
+  void save(io::StateArchive& archive, const std::string& prefix) const;
+  void load(const io::StateArchive& archive, const std::string& prefix);
+
+ private:
+  void advance_bodies(double t, double dt, double damping);
+  void drive_bodies(double dt, const std::vector<Vec<2>>& x, ConstFieldView<double, 2> v, ConstFieldView<double, NS> s);
+  void select(const std::vector<Vec<2>>& x, ConstFieldView<double, 2> v, ConstFieldView<double, NS> s);
+  void measure(const std::vector<Vec<2>>& x, ConstFieldView<double, 2> v, ConstFieldView<double, NS> s);
+
+  std::vector<RigidBody> bodies_;
+  std::vector<BodyState> state_;
+  std::vector<Vec<2>> velocity_half_, velocity_end_;  // per body, over the current step
+  std::vector<Vec<2>> applied_;                       // per body: the applied force at t^{n+1/2}, N/m
+  double damping_ = 0.0;                              // c_d over the current step, 1/s
+  FunctionValue functions_;
+  double dx_, join_, keep_, depth_, adjacent_;
+  // Per node: kMaxContacts slots.
+  std::vector<int> body_, previous_body_;
+  std::vector<Vec<2>> normal_;
+  std::vector<std::int8_t> slip_, previous_slip_;
+  std::vector<std::uint8_t> in_contact_;
+  std::vector<Vec<2>> x_begin_;                        // positions at t^n (contact nodes only are read)
+  std::vector<std::pair<double, std::size_t>> along_;  // (s, node) of one body's contact nodes
+  std::vector<double> last_power_;                     // per body, F.V at the last measure
+  double power_ = 0.0;
+  bool selected_ = false;
+};
+
+}  // namespace rktsph

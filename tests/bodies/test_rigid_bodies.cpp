@@ -1,0 +1,501 @@
+// Rigid bodies in V2 (method-notes §4.5) on whole runs:
+//   - a smooth plate compressing an elastic block between a smooth base and smooth (roller)
+//     walls at a prescribed velocity: the reactions against the exact oedometric solution, the
+//     plate's reaction against a section cut and against the power balance;
+//   - a force-driven plate settling on the same block to the exact settlement;
+//   - a rough footing pushed into a block: bit-identical on 1 and 2 threads;
+//   - the [[body]] keys of the case file, their errors, and bodies.csv from the command line.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "../support/test_util.hpp"
+#include "case/case_builder.hpp"
+#include "core/error.hpp"
+#include "schemes/simulation.hpp"
+#include "schemes/v2_stages.hpp"
+
+namespace rktsph {
+namespace {
+
+constexpr double kE = 1.0e7, kNu = 0.3, kRho = 2000.0;
+const double kOedometric = kE * (1.0 - kNu) / ((1.0 + kNu) * (1.0 - 2.0 * kNu));  // lambda + 2G
+
+BodySpec plane_body(const std::string& name, const Vec<2>& point, const Vec<2>& normal, ContactLaw law) {
+  BodySpec b;
+  b.name = name;
+  b.where = "test";
+  b.shape = BodyShape::plane;
+  b.points = {point};
+  b.normal = normal;
+  b.law = law;
+  return b;
+}
+
+int function_named(const CaseSetup<2>& c, const std::string& name) {
+  for (std::size_t k = 0; k < c.function_names.size(); ++k) {
+    if (c.function_names[k] == name) return static_cast<int>(k);
+  }
+  return -1;
+}
+
+const RigidContact& contact_of(const Simulation<2>& sim) {
+  const auto* stage = sim.scheme().find<ContactEnforce>();
+  if (stage == nullptr) throw std::runtime_error("no contact stage");
+  return stage->contact();
+}
+
+// The unit block [0, 1]^2 at dx = 0.1 between a smooth base and smooth walls, with a smooth
+// top plate; `plate` says how the plate moves.
+// No damping: the velocity damping of the stress points' half step is a splitting error of
+// order c_d dt against a kinematically driven boundary (the plate moves the contact nodes at V,
+// the stress sees the damped velocities): 2.6 % low in sigma_yy here with c_d = 100 1/s,
+// dt = 0.6 ms. The loads rise over about one period of the block's first mode instead, and the
+// quasi-static values are the means over the last periods.
+CaseSetup<2> oedometer(double end, const std::function<void(CaseBuilder<2>&)>& functions,
+                       const std::function<void(CaseSetup<2>&, BodySpec&)>& plate) {
+  CaseBuilder<2> b("oedometer with rigid bodies");
+  b.spacing(0.1)
+      .block(Vec<2>(0.0, 0.0), Vec<2>(1.0, 1.0))
+      .elastic(kE, kNu, kRho)
+      .scheme("v2")
+      .free_surface(true)
+      .time(end, 0.5);
+  functions(b);
+  CaseSetup<2> c = b.build();
+  c.bodies.push_back(plane_body("base", Vec<2>(0.0, 0.0), Vec<2>(0.0, 1.0), ContactLaw::smooth));
+  c.bodies.push_back(plane_body("left", Vec<2>(0.0, 0.0), Vec<2>(1.0, 0.0), ContactLaw::smooth));
+  c.bodies.push_back(plane_body("right", Vec<2>(1.0, 0.0), Vec<2>(-1.0, 0.0), ContactLaw::smooth));
+  BodySpec top = plane_body("plate", Vec<2>(0.0, 1.0), Vec<2>(0.0, -1.0), ContactLaw::smooth);
+  plate(c, top);
+  c.bodies.push_back(top);
+  return c;
+}
+
+// The section cut y = y0 over the whole width: F = -sum sigma_yy V / dx over the stress points
+// of the slab |y - y0| < dx/2 (method-notes §4.5, "Section cut"), compressive positive.
+double section_cut(const Simulation<2>& sim, double y0, double dx) {
+  const auto s = sim.stress_point_stress();
+  const auto& x = sim.stress_points().position;
+  double f = 0.0;
+  for (std::size_t e = 0; e < x.size(); ++e) {
+    if (std::abs(x[e][1] - y0) < 0.5 * dx) f -= s(e, StressComponent::yy) * sim.stress_points().volume[e] / dx;
+  }
+  return f;
+}
+
+// Means of a body's reaction, displacement and of a section cut over the steps from `from`.
+struct Means {
+  double force = 0.0, force_x_left = 0.0, force_x_right = 0.0, base = 0.0, settlement = 0.0, cut = 0.0;
+  long samples = 0;
+};
+
+Means run_and_average(Simulation<2>& sim, double end, double from) {
+  Means m;
+  while (sim.time() < end - 1e-12) {
+    sim.step();
+    if (sim.time() < from) continue;
+    const auto& st = contact_of(sim).state();
+    m.base += st[0].force[1];
+    m.force_x_left += st[1].force[0];
+    m.force_x_right += st[2].force[0];
+    m.force += st[3].force[1];
+    m.settlement -= st[3].offset[1];
+    m.cut += section_cut(sim, 0.45, 0.1);
+    ++m.samples;
+  }
+  const double n = static_cast<double>(m.samples);
+  m.base /= n;
+  m.force_x_left /= n;
+  m.force_x_right /= n;
+  m.force /= n;
+  m.settlement /= n;
+  m.cut /= n;
+  return m;
+}
+
+TEST(RigidBodies, SmoothPlateCompressesABlockToTheOedometricSolution) {
+  const test::ThreadCount threads(1);
+  // The plate's velocity rises linearly over 0.05 s (about the period 4H/c = 0.049 s of the
+  // first mode, which a ramp of one period leaves almost unexcited), is held, and falls again:
+  // 1 mm in all (strain 1e-3), then the plate rests.
+  const double v0 = 1.0e-3 / 0.25;
+  CaseSetup<2> c = oedometer(
+      0.5,
+      [&](CaseBuilder<2>& b) {
+        TimeFunction f;
+        f.kind = TimeFunction::Kind::table;
+        f.times = {0.0, 0.05, 0.25, 0.30};
+        f.values = {0.0, 1.0, 1.0, 0.0};
+        b.function("push", f);
+      },
+      [&](CaseSetup<2>& setup, BodySpec& top) {
+        top.velocity = {0.0, -v0};
+        top.velocity_function = {-1, function_named(setup, "push")};
+      });
+  Simulation<2> sim(std::move(c));
+  const Means mean = run_and_average(sim, 0.5, 0.35);
+  const RigidContact& contact = contact_of(sim);
+  const BodyState& base = contact.state()[0];
+  const BodyState& left = contact.state()[1];
+  const BodyState& right = contact.state()[2];
+  const BodyState& plate = contact.state()[3];
+  const double settlement = -plate.offset[1];
+  EXPECT_NEAR(settlement, 1.0e-3, 1e-9);
+  const double exact = kOedometric * settlement / 1.0 * 1.0;  // N/m: M (delta / H) W
+  const double plate_error = std::abs(mean.force - exact) / exact;
+  const double base_error = std::abs(-mean.base - exact) / exact;
+  // The walls carry sigma_xx = nu / (1 - nu) sigma_yy over the (compressed) height.
+  const double wall_exact = kNu / (1.0 - kNu) * exact * (1.0 - settlement);
+  const double wall_error =
+      std::max(std::abs(-mean.force_x_left - wall_exact), std::abs(mean.force_x_right - wall_exact)) / wall_exact;
+  const double cut_error = std::abs(mean.cut - mean.force) / exact;
+  // The power balance: the work of the soil on the plate is minus the work the contacts did on
+  // the soil (its energy account), which is the strain and kinetic energy; the elastic energy
+  // of the compressed block is 1/2 F delta.
+  const EnergyBalance e = sim.energy();
+  const double work_error = std::abs(e.external_work + plate.work) / std::abs(plate.work);
+  const double elastic = 0.5 * exact * settlement;
+  const double energy_error = std::abs((e.strain - e.initial_strain + e.kinetic) - elastic) / elastic;
+  const double imbalance = std::abs(e.imbalance()) / std::abs(e.external_work);
+  std::fprintf(stderr,
+               "oedometer: mean F = %.6g N/m (exact %.6g, error %.2e), base %.2e, walls %.2e, cut %.2e, "
+               "work %.2e, energy %.2e, imbalance %.2e, contact nodes %ld/%ld, width %.4f, projections %ld\n",
+               mean.force, exact, plate_error, base_error, wall_error, cut_error, work_error, energy_error, imbalance,
+               plate.contact_nodes, base.contact_nodes, plate.width, plate.node_projections);
+  EXPECT_LT(plate_error, 5e-3);
+  EXPECT_LT(base_error, 5e-3);
+  EXPECT_LT(wall_error, 1e-2);
+  EXPECT_LT(cut_error, 5e-3);
+  EXPECT_LT(work_error, 1e-3);
+  EXPECT_LT(energy_error, 1e-2);
+  EXPECT_LT(imbalance, 1e-2);
+  EXPECT_EQ(plate.contact_nodes, 11);
+  EXPECT_EQ(base.contact_nodes, 11);
+  EXPECT_NEAR(plate.width, 1.0, 1e-9);
+  EXPECT_EQ(plate.node_projections + base.node_projections + left.node_projections + right.node_projections, 0);
+  // No node of the confined block is taken for free surface.
+  const Field<double, 1> flags = sim.nodes().template find<double, 1>("free_surface");
+  double flagged = 0.0;
+  for (Index i = 0; i < sim.nodes().size(); ++i) flagged += sim.nodes().view(flags)(i, 0);
+  EXPECT_EQ(flagged, 0.0);
+}
+
+TEST(RigidBodies, ForceDrivenPlateSettlesToTheExactSettlement) {
+  const test::ThreadCount threads(1);
+  const double load = 1.3e4;  // N/m over the 1 m wide plate
+  // The load rises linearly over 0.1 s, about two periods of the plate on the block.
+  CaseSetup<2> c = oedometer(
+      0.6, [&](CaseBuilder<2>& b) { b.function("load", TimeFunction::ramp(0.1)); },
+      [&](CaseSetup<2>& setup, BodySpec& top) {
+        top.force_driven = {false, true};
+        top.force = {0.0, -load};
+        top.force_function = {-1, function_named(setup, "load")};
+        top.mass = 100.0;  // kg/m, a twentieth of the block
+      });
+  Simulation<2> sim(std::move(c));
+  const Means mean = run_and_average(sim, 0.6, 0.2);
+  const double exact = load * 1.0 / (1.0 * kOedometric);  // P H / (W M)
+  const double error = std::abs(mean.settlement - exact) / exact;
+  const double force_error = std::abs(mean.force - load) / load;
+  const double cut_error = std::abs(mean.cut - load) / load;
+  std::fprintf(stderr, "force-driven plate: mean settlement %.6g m (exact %.6g, error %.2e), reaction %.2e, cut %.2e\n",
+               mean.settlement, exact, error, force_error, cut_error);
+  EXPECT_LT(error, 5e-3);
+  EXPECT_LT(force_error, 5e-3);
+  EXPECT_LT(cut_error, 5e-3);
+}
+
+// A rough footing pushed into a block with a rough base and smooth walls.
+CaseSetup<2> footing_case() {
+  CaseBuilder<2> b("rough footing");
+  b.spacing(0.1)
+      .block(Vec<2>(0.0, 0.0), Vec<2>(2.0, 1.0))
+      .elastic(kE, kNu, kRho)
+      .scheme("v2")
+      .free_surface(true)
+      .time(0.04, 0.5);
+  CaseSetup<2> c = b.build();
+  c.bodies.push_back(plane_body("base", Vec<2>(0.0, 0.0), Vec<2>(0.0, 1.0), ContactLaw::rough));
+  c.bodies.push_back(plane_body("axis", Vec<2>(0.0, 0.0), Vec<2>(1.0, 0.0), ContactLaw::smooth));
+  BodySpec f;
+  f.name = "footing";
+  f.where = "test";
+  f.shape = BodyShape::segment;
+  f.points = {Vec<2>(0.55, 1.0), Vec<2>(0.0, 1.0)};
+  f.law = ContactLaw::coulomb;
+  f.friction = 0.3;
+  f.velocity = {0.0, -0.05};
+  c.bodies.push_back(f);
+  return c;
+}
+
+TEST(RigidBodies, FootingRunIsBitIdenticalOnOneAndTwoThreads) {
+  auto run = [](int n) {
+    const test::ThreadCount threads(n);
+    Simulation<2> sim(footing_case());
+    while (sim.time() < 0.04 - 1e-12) sim.step();
+    return std::make_pair(sim.nodes().position, contact_of(sim).state()[2].force);
+  };
+  const auto one = run(1);
+  const auto two = run(2);
+  ASSERT_EQ(one.first.size(), two.first.size());
+  for (std::size_t i = 0; i < one.first.size(); ++i) {
+    ASSERT_EQ(one.first[i][0], two.first[i][0]) << "node " << i;
+    ASSERT_EQ(one.first[i][1], two.first[i][1]) << "node " << i;
+  }
+  EXPECT_EQ(one.second[0], two.second[0]);
+  EXPECT_EQ(one.second[1], two.second[1]);
+  EXPECT_GT(one.second[1], 0.0);  // the soil pushes the footing up
+}
+
+constexpr const char* kBodyCase = R"(
+[geometry]
+dimension = 2
+spacing = 0.1
+[[geometry.block]]
+min = [0.0, 0.0]
+max = [1.0, 0.5]
+[material]
+model = "elastic"
+E = 1.0e7
+nu = 0.3
+density = 2000.0
+[functions]
+push = { type = "ramp", duration = 0.01, scale = -0.05 }
+[solver]
+version = "v2"
+[[body]]
+name = "base"
+plane = { point = [0.0, 0.0], normal = [0.0, 1.0] }
+contact = "coulomb"
+friction = 0.4
+adhesion = 5.0e3
+[[body]]
+name = "footing"
+segment = { a = [0.3, 0.5], b = [0.0, 0.5] }
+contact = "rough"
+velocity = { y = "push" }
+[[body]]
+name = "wall"
+polyline = [[1.0, 0.0], [1.0, 1.0]]
+contact = "smooth"
+force = { x = -100.0 }
+mass = 50.0
+[time]
+end = 2.0e-3
+cfl = 0.5
+[output]
+interval = 1.0e-3
+)";
+
+TEST(RigidBodies, CaseFileKeys) {
+  test::TempDir dir;
+  const CaseSetup<2> c = test::case_from_string<2>(dir, kBodyCase);
+  ASSERT_EQ(c.bodies.size(), 3u);
+  EXPECT_EQ(c.bodies[0].shape, BodyShape::plane);
+  EXPECT_EQ(c.bodies[0].law, ContactLaw::coulomb);
+  EXPECT_DOUBLE_EQ(c.bodies[0].friction, 0.4);
+  EXPECT_DOUBLE_EQ(c.bodies[0].adhesion, 5.0e3);
+  EXPECT_EQ(c.bodies[1].shape, BodyShape::segment);
+  EXPECT_EQ(c.bodies[1].velocity_function[1], function_named(c, "push"));
+  EXPECT_DOUBLE_EQ(c.bodies[1].velocity[1], 1.0);  // the function's value is the velocity
+  EXPECT_EQ(c.bodies[2].shape, BodyShape::polyline);
+  EXPECT_TRUE(c.bodies[2].force_driven[0]);
+  EXPECT_FALSE(c.bodies[2].force_driven[1]);
+  EXPECT_DOUBLE_EQ(c.bodies[2].force[0], -100.0);
+  EXPECT_DOUBLE_EQ(c.bodies[2].mass, 50.0);
+}
+
+// Each bad [[body]] gets an InputError naming the file, the line and the key.
+TEST(RigidBodies, CaseFileErrorsNameFileLineAndKey) {
+  struct Bad {
+    std::string from, to, expect;
+  };
+  const std::vector<Bad> bad = {
+      {"polyline = [[1.0, 0.0], [1.0, 1.0]]", "polyline = [[1.0, 0.0]]", "key 'body[2].polyline': has no segment"},
+      {"contact = \"smooth\"", "contact = \"sticky\"", "key 'body[2].contact': unknown contact law 'sticky'"},
+      {"friction = 0.4", "friction = -0.1", "key 'body[0].friction': must be >= 0"},
+      {"version = \"v2\"", "version = \"v1\"", "key 'body': rigid bodies need solver.version = \"v2\""},
+      {"mass = 50.0\n", "", "missing required key 'body[2].mass'"},
+      {"segment = { a = [0.3, 0.5], b = [0.0, 0.5] }", "segment = { a = [0.3, 0.5], b = [0.3, 0.5] }",
+       "key 'body[1].segment.b': coincides with a"},
+      {"contact = \"rough\"", "contact = \"rough\"\nfriction = 0.2",
+       "key 'body[1].friction': a friction coefficient needs"},
+  };
+  for (const Bad& b : bad) {
+    std::string text = kBodyCase;
+    const auto at = text.find(b.from);
+    ASSERT_NE(at, std::string::npos) << b.from;
+    text.replace(at, b.from.size(), b.to);
+    test::TempDir dir;
+    try {
+      (void)test::case_from_string<2>(dir, text);
+      ADD_FAILURE() << "no error for: " << b.to;
+    } catch (const InputError& e) {
+      const std::string message = e.what();
+      EXPECT_NE(message.find("case.toml, line "), std::string::npos) << message;
+      EXPECT_NE(message.find(b.expect), std::string::npos) << message;
+    }
+  }
+}
+
+// From the command line: bodies.csv has a row per body at every output step, summary.json the
+// reactions and counts.
+TEST(RigidBodies, RunWritesBodiesCsvAndSummary) {
+  test::TempDir dir;
+  const std::string file = dir.write("case.toml", kBodyCase);
+  const auto result =
+      test::run_command(fmt::format("{} run {} --out {} -q -j 1 2>&1", RKTSPH_BINARY, file, dir.file("out")));
+  ASSERT_EQ(result.status, 0) << result.out;
+  const std::string csv = test::read_text(dir.file("out/bodies.csv"));
+  EXPECT_EQ(csv.rfind("t,body,ux,uy,vx,vy,Fx,Fy,contact_width,contact_nodes,", 0), 0u);
+  int rows = 0;
+  for (const char ch : csv) rows += ch == '\n' ? 1 : 0;
+  EXPECT_EQ(rows, 1 + 3 * 3);  // header, then 3 bodies at t = 0, 1e-3, 2e-3
+  EXPECT_NE(csv.find(",footing,"), std::string::npos);
+  const auto summary = nlohmann::json::parse(test::read_text(dir.file("out/summary.json")));
+  const auto& stage = summary.at("stages").at("contact_enforce");
+  EXPECT_GT(stage.at("footing.Fy").get<double>(), 0.0);
+  EXPECT_EQ(stage.at("footing.contact_nodes").get<double>(), 4.0);
+  EXPECT_TRUE(stage.contains("base.node_projections"));
+}
+
+}  // namespace
+}  // namespace rktsph
+
+namespace rktsph {
+namespace {
+
+// Coulomb at the scale of a run: an elastic block pressed onto a Coulomb base by a rough plate
+// pushed down with a force P, then dragged sideways by the plate. The base holds the block
+// until the shear reaches mu P + a W, then the block slides and the plate's horizontal
+// reaction stays at that limit. The block is low (H = W/5) so that the overturning moment of the
+// drag, mu P H, keeps the base in compression (eccentricity mu H = W/17 < W/6).
+//
+// NOT MET, disabled (docs/VALIDATION.md, "Rigid bodies"): the run is stable and the base
+// slides with the plate (1.03 mm over 0.2 s, the plate's 1 mm), but the plate's shear reaction
+// is 4.03 kN/m against mu P + a W = 3.47 kN/m (16 %). The base's own reaction is held at the
+// limit by the slip condition, so the shear carried through the block to the rough plate is
+// not in equilibrium with it: a sliding node's prescribed shear does not yet enter its own
+// stress gradient in step 2 (a first attempt at that, with the difference form, gave 25 %).
+TEST(RigidBodies, DISABLED_BlockDraggedOverACoulombBaseSlidesAtTheFrictionLimit) {
+  const test::ThreadCount threads(1);
+  const double load = 1.0e4, mu = 0.3, adhesion = 500.0;  // N/m, -, Pa
+  CaseBuilder<2> b("block dragged over a Coulomb base");
+  b.spacing(0.05)
+      .block(Vec<2>(0.0, 0.0), Vec<2>(1.0, 0.2))
+      .elastic(kE, kNu, kRho)
+      .scheme("v2")
+      .free_surface(true)
+      .time(0.4, 0.5);
+  TimeFunction press = TimeFunction::ramp(0.05);
+  TimeFunction drag = TimeFunction::ramp(0.05, 0.1);  // from t = 0.1 s
+  b.function("press", press).function("drag", drag);
+  CaseSetup<2> c = b.build();
+  BodySpec base = plane_body("base", Vec<2>(0.0, 0.0), Vec<2>(0.0, 1.0), ContactLaw::coulomb);
+  base.friction = mu;
+  base.adhesion = adhesion;
+  c.bodies.push_back(base);
+  BodySpec plate;
+  plate.name = "plate";
+  plate.where = "test";
+  plate.shape = BodyShape::segment;
+  plate.points = {Vec<2>(1.0, 0.2), Vec<2>(0.0, 0.2)};  // soil below
+  plate.law = ContactLaw::rough;
+  plate.velocity = {0.005, 0.0};
+  plate.velocity_function = {function_named(c, "drag"), -1};
+  plate.force_driven = {false, true};
+  plate.force = {0.0, -load};
+  plate.force_function = {-1, function_named(c, "press")};
+  plate.mass = 200.0;
+  c.bodies.push_back(plate);
+  Simulation<2> sim(std::move(c));
+  double shear = 0.0, pressure = 0.0, plate_load = 0.0, base_slip = 0.0;
+  long samples = 0;
+  std::vector<Vec<2>> start;
+  while (sim.time() < 0.4 - 1e-12) {
+    sim.step();
+    if (sim.time() >= 0.2 && start.empty()) start = sim.nodes().position;
+    if (sim.time() < 0.25) continue;
+    const auto& st = contact_of(sim).state();
+    shear += st[1].force[0];
+    pressure -= st[0].force[1];
+    plate_load += st[1].force[1];
+    ++samples;
+  }
+  shear /= static_cast<double>(samples);
+  pressure /= static_cast<double>(samples);
+  plate_load /= static_cast<double>(samples);
+  // The block's base moved with the plate: it slides.
+  const auto& x = sim.nodes().position;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    if (start[i][1] < 1e-9) base_slip = std::max(base_slip, x[i][0] - start[i][0]);
+  }
+  const RigidContact& contact = contact_of(sim);
+  const double width = contact.state()[0].width;
+  const double limit = mu * pressure + adhesion * width;
+  const double error = std::abs(-shear - limit) / limit;
+  std::fprintf(stderr,
+               "Coulomb drag: plate shear %.6g N/m, limit mu P + a W = %.6g (base P = %.6g, plate %.6g, W = %.4g), "
+               "error %.2e, base slip over 0.2 s %.4g m\n",
+               -shear, limit, pressure, plate_load, width, error, base_slip);
+  EXPECT_NEAR(pressure, load, 0.02 * load);
+  EXPECT_NEAR(plate_load, load, 0.02 * load);
+  EXPECT_NEAR(width, 1.0, 1e-6);
+  EXPECT_LT(error, 0.03);
+  EXPECT_GT(base_slip, 0.5 * 0.005 * 0.2);
+}
+
+}  // namespace
+}  // namespace rktsph
+
+namespace rktsph {
+namespace {
+
+// Simple shear of a 1 x 0.2 m block between a fixed bonded base and a bonded plate moving at
+// 5 mm/s: stable (before the contact nodes' velocity entered their own gradient, method-notes
+// §4.5, this run grew without bound, the shear doubling every 0.036 s), the plate's and the
+// base's shear reactions balance, and the mean shear stays below G gamma (the free sides carry
+// no shear) but near it.
+TEST(RigidBodies, SimpleShearBetweenBondedPlatesIsStable) {
+  const test::ThreadCount threads(1);
+  CaseBuilder<2> b("simple shear");
+  b.spacing(0.05)
+      .block(Vec<2>(0.0, 0.0), Vec<2>(1.0, 0.2))
+      .elastic(kE, kNu, kRho)
+      .scheme("v2")
+      .free_surface(true)
+      .time(0.33, 0.5)
+      .function("drag", TimeFunction::ramp(0.05));
+  CaseSetup<2> c = b.build();
+  c.bodies.push_back(plane_body("base", Vec<2>(0.0, 0.0), Vec<2>(0.0, 1.0), ContactLaw::bonded));
+  BodySpec plate = plane_body("plate", Vec<2>(0.0, 0.2), Vec<2>(0.0, -1.0), ContactLaw::bonded);
+  plate.velocity = {0.005, 0.0};
+  plate.velocity_function = {function_named(c, "drag"), -1};
+  c.bodies.push_back(plate);
+  Simulation<2> sim(std::move(c));
+  double kinetic = 0.0;
+  while (sim.time() < 0.33 - 1e-12) {
+    sim.step();
+    kinetic = std::max(kinetic, sim.energy().kinetic);
+  }
+  const auto& st = contact_of(sim).state();
+  const double shear_modulus = kE / (2.0 * (1.0 + kNu));
+  const double gamma = st[1].offset[0] / 0.2;
+  const double ratio = -st[1].force[0] / (shear_modulus * gamma * 1.0);
+  const double balance = std::abs(st[0].force[0] + st[1].force[0]) / std::abs(st[1].force[0]);
+  std::fprintf(stderr, "simple shear: plate F_x %.6g N/m, G gamma W %.6g, ratio %.4f, balance %.2e, peak K %.3g J\n",
+               -st[1].force[0], shear_modulus * gamma, ratio, balance, kinetic);
+  EXPECT_LT(balance, 1e-3);
+  EXPECT_GT(ratio, 0.7);
+  EXPECT_LT(ratio, 1.0);
+  EXPECT_LT(kinetic, 0.01);  // the block's own motion, 1/2 m (v/2)^2 = 1.25e-3 J
+}
+
+}  // namespace
+}  // namespace rktsph
