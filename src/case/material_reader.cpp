@@ -193,6 +193,23 @@ void read_frictional(const io::Section& s, Parameters& p) {
   s.require(p.residual_cohesion > 0.0 && p.residual_cohesion <= p.cohesion, "residual_cohesion",
             fmt::format("the residual cohesion must lie in (0, {}] Pa (the initial cohesion), got {}", p.cohesion,
                         p.residual_cohesion));
+  // The tension cut-off on the mean stress (method-notes §1.12): absent, none. Beyond the sharp
+  // apex c cot(phi) it would bound no state the shear surface admits.
+  if (s.has("tension_cutoff")) {
+    p.tension_cutoff.active = true;
+    p.tension_cutoff.limit = s.number("tension_cutoff");
+    const double apex = p.friction_angle > 0.0 ? p.cohesion / std::tan(p.friction_angle) : 0.0;
+    if (p.friction_angle > 0.0) {
+      s.require(p.tension_cutoff.limit >= 0.0 && p.tension_cutoff.limit <= apex, "tension_cutoff",
+                fmt::format("the tension cut-off (largest mean stress) must lie in [0, {}] Pa (the apex c cot(phi)), "
+                            "got {}",
+                            apex, p.tension_cutoff.limit));
+    } else {
+      s.require(
+          p.tension_cutoff.limit >= 0.0, "tension_cutoff",
+          fmt::format("the tension cut-off (largest mean stress) must be >= 0 Pa, got {}", p.tension_cutoff.limit));
+    }
+  }
   p.fluidity = read_fluidity(s);
   p.overstress = read_overstress(s);
 }
@@ -216,6 +233,12 @@ std::unique_ptr<Material> read_perzyna_drucker_prager(const io::Section& s) {
 std::unique_ptr<Material> read_perzyna_mohr_coulomb(const io::Section& s) {
   MohrCoulombParameters p;
   read_frictional(s, p);
+  const double transition = s.number("lode_transition", LodeFactor::kDefaultTransitionDegrees);
+  s.require(transition >= LodeFactor::kMinTransitionDegrees && transition <= LodeFactor::kMaxTransitionDegrees,
+            "lode_transition",
+            fmt::format("the Lode transition angle must lie in [{}, {}] degrees, got {}",
+                        LodeFactor::kMinTransitionDegrees, LodeFactor::kMaxTransitionDegrees, transition));
+  p.lode_transition = transition * std::numbers::pi / 180.0;
   return make_perzyna_mohr_coulomb(p);
 }
 
@@ -235,10 +258,12 @@ const std::vector<Entry>& models() {
        "(history: eps_vp_eq, eps_vp_vol, p_c)",
        read_perzyna_cam_clay},
       {"perzyna_drucker_prager",
-       "Perzyna viscoplastic Drucker-Prager (c, phi, dilatancy, rounded apex, c softening; history: eps_vp_eq)",
+       "Perzyna viscoplastic Drucker-Prager (c, phi, dilatancy, rounded apex, tension cut-off, c softening; "
+       "history: eps_vp_eq)",
        read_perzyna_drucker_prager},
       {"perzyna_mohr_coulomb",
-       "Perzyna viscoplastic Mohr-Coulomb, Abbo-Sloan rounding (c, phi, dilatancy, c softening; history: eps_vp_eq)",
+       "Perzyna viscoplastic Mohr-Coulomb, Abbo-Sloan rounding (c, phi, dilatancy, tension cut-off, c softening; "
+       "history: eps_vp_eq)",
        read_perzyna_mohr_coulomb},
   };
   return kModels;

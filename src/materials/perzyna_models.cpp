@@ -66,20 +66,23 @@ std::unique_ptr<Material> make_perzyna_drucker_prager(const DruckerPragerParamet
   h.Y0 = cone.xi * p.cohesion;
   h.H = cone.xi * p.hardening_modulus;
   h.Y_residual = cone.xi * p.residual_cohesion;
-  return std::make_unique<PerzynaMaterial<DruckerPragerSurface, LinearHardening>>("perzyna_drucker_prager", p.elastic,
-                                                                                  surf, h, p.overstress, p.fluidity);
+  return std::make_unique<PerzynaMaterial<DruckerPragerSurface, LinearHardening>>(
+      "perzyna_drucker_prager", p.elastic, surf, h, p.overstress, p.fluidity, PressureDependentModuli{},
+      p.tension_cutoff);
 }
 
 std::unique_ptr<Material> make_perzyna_mohr_coulomb(const MohrCoulombParameters& p) {
-  const MohrCoulombSurface surf = MohrCoulombSurface::make(p.friction_angle, p.dilatancy, p.apex_rounding);
+  const MohrCoulombSurface surf =
+      MohrCoulombSurface::make(p.friction_angle, p.dilatancy, p.apex_rounding, p.lode_transition);
   // Y = sqrt(3) cos(phi) c (eq. 1.11.1) with the linear law of c (eq. 1.10.8).
   const double xi = std::sqrt(3.0) * std::cos(p.friction_angle);
   LinearHardening h;
   h.Y0 = xi * p.cohesion;
   h.H = xi * p.hardening_modulus;
   h.Y_residual = xi * p.residual_cohesion;
-  return std::make_unique<PerzynaMaterial<MohrCoulombSurface, LinearHardening>>("perzyna_mohr_coulomb", p.elastic, surf,
-                                                                                h, p.overstress, p.fluidity);
+  return std::make_unique<PerzynaMaterial<MohrCoulombSurface, LinearHardening>>(
+      "perzyna_mohr_coulomb", p.elastic, surf, h, p.overstress, p.fluidity, PressureDependentModuli{},
+      p.tension_cutoff);
 }
 
 }  // namespace rktsph

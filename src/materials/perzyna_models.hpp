@@ -5,7 +5,9 @@
 
 #include "materials/material.hpp"
 #include "materials/overstress.hpp"
+#include "materials/tension_cutoff.hpp"
 #include "materials/yield_drucker_prager.hpp"
+#include "materials/yield_mohr_coulomb.hpp"
 
 namespace rktsph {
 
@@ -57,13 +59,15 @@ struct DruckerPragerParameters {
   double apex_rounding = 0.1;      // eps of delta = eps sin(angle) Y, in [0, 1)
   double hardening_modulus = 0.0;  // H_c = dc/d eps_vp_eq, Pa (negative: softening)
   double residual_cohesion = 0.0;  // floor of c, Pa, in (0, c0]
+  TensionCutoff tension_cutoff;    // largest mean stress, Pa (method-notes §1.12); off by default
   double fluidity = 0.0;           // gamma, 1/s
   Overstress overstress;
 };
 std::unique_ptr<Material> make_perzyna_drucker_prager(const DruckerPragerParameters& parameters);
 
 /// perzyna_mohr_coulomb (method-notes §1.11): Abbo–Sloan rounded pyramid, potential of
-/// dilatancy psi, c = max(c0 + H_c eps_vp_eq, c_residual). The keys of Drucker–Prager but dp_match.
+/// dilatancy psi, c = max(c0 + H_c eps_vp_eq, c_residual). The keys of Drucker–Prager but
+/// dp_match, plus lode_transition.
 struct MohrCoulombParameters {
   ElasticConstants elastic;
   double cohesion = 0.0;           // c0, Pa, > 0
@@ -72,8 +76,11 @@ struct MohrCoulombParameters {
   double apex_rounding = 0.1;      // eps of delta = eps sin(angle) Y, in [0, 1)
   double hardening_modulus = 0.0;  // H_c = dc/d eps_vp_eq, Pa (negative: softening)
   double residual_cohesion = 0.0;  // floor of c, Pa, in (0, c0]
+  TensionCutoff tension_cutoff;    // largest mean stress, Pa (method-notes §1.12); off by default
   double fluidity = 0.0;           // gamma, 1/s
   Overstress overstress;
+  // theta_T of the Lode rounding, radians (eq. 1.11.2; key lode_transition, in degrees).
+  double lode_transition = LodeFactor::kDefaultTransition;
 };
 std::unique_ptr<Material> make_perzyna_mohr_coulomb(const MohrCoulombParameters& parameters);
 

@@ -4,8 +4,10 @@
 //   F = sqrt(q^2 K_phi(theta)^2 + delta_F^2) − sqrt(3) sin(phi) p′,   Y = sqrt(3) c cos(phi)   (1.11.1)
 //   Q = sqrt(q^2 K_psi(theta)^2 + delta_Q^2) − sqrt(3) sin(psi) p′                             (1.11.4)
 // with delta = eps sin(angle) Y as in §1.10. K(theta) is the exact Mohr–Coulomb
-// cos(theta) − sin(angle) sin(theta)/sqrt(3) for |theta| <= theta_T = 29 deg and A − B sin(3 theta)
-// beyond (eq. 1.11.2), so F is smooth at the corners theta = ±30 deg. The Lode derivative is
+// cos(theta) − sin(angle) sin(theta)/sqrt(3) for |theta| <= theta_T and A − B sin(3 theta) beyond
+// (eq. 1.11.2), so F is smooth at the corners theta = ±30 deg. theta_T is the material key
+// lode_transition, default 29.7 deg (the triaxial peak within 0.7 % of the sharp pyramid up to
+// phi = 40 deg; method-notes §1.11). The Lode derivative is
 // taken through x = sin(3 theta) (as for Cam-Clay, method-notes §1.8): no cos(3 theta) -> 0.
 // With phi = psi = 0 this is a rounded Tresca with Y = sqrt(3) c (equal to von Mises at theta = 0).
 #include <algorithm>
@@ -19,17 +21,25 @@ namespace rktsph {
 
 /// The Lode factor K(x), x = sin(3 theta), of eqs. (1.11.2)–(1.11.3) for one angle (phi or psi).
 struct LodeFactor {
-  static constexpr double kTransitionAngle = 29.0 * std::numbers::pi / 180.0;  // theta_T
+  /// Default theta_T and its admissible range, degrees (the key lode_transition). The rounding's
+  /// curvature d2K/dtheta2 = 9 B sin(3 theta) grows like 1/cos(3 theta_T): 19 at 29 deg, 64 at
+  /// the default 29.7 deg, 191 at the upper end 29.9 deg.
+  static constexpr double kDefaultTransitionDegrees = 29.7;
+  static constexpr double kMinTransitionDegrees = 20.0;
+  static constexpr double kMaxTransitionDegrees = 29.9;
+  static constexpr double kDefaultTransition = kDefaultTransitionDegrees * std::numbers::pi / 180.0;
 
   double sin_angle = 0.0;
-  double A_plus = 0.0, B_plus = 0.0;    // rounding for theta > theta_T
-  double A_minus = 0.0, B_minus = 0.0;  // rounding for theta < −theta_T
+  double transition = kDefaultTransition;  // theta_T, radians
+  double A_plus = 0.0, B_plus = 0.0;       // rounding for theta > theta_T
+  double A_minus = 0.0, B_minus = 0.0;     // rounding for theta < −theta_T
 
   /// A and B from continuity of K and dK/dtheta at ±theta_T (eq. 1.11.3).
-  static LodeFactor of(double sin_angle) {
+  static LodeFactor of(double sin_angle, double transition = kDefaultTransition) {
     LodeFactor f;
     f.sin_angle = sin_angle;
-    const double t = kTransitionAngle, r3 = std::sqrt(3.0);
+    f.transition = transition;
+    const double t = transition, r3 = std::sqrt(3.0);
     for (double sign : {1.0, -1.0}) {
       const double B = (sign * std::sin(t) + sin_angle * std::cos(t) / r3) / (3.0 * std::cos(3.0 * t));
       const double A = std::cos(t) - sign * sin_angle * std::sin(t) / r3 + B * sign * std::sin(3.0 * t);
@@ -47,12 +57,12 @@ struct LodeFactor {
   Value operator()(double x) const {
     x = std::clamp(x, -1.0, 1.0);
     const double theta = std::asin(x) / 3.0;
-    if (theta > kTransitionAngle) return {A_plus - B_plus * x, -B_plus};
-    if (theta < -kTransitionAngle) return {A_minus - B_minus * x, -B_minus};
+    if (theta > transition) return {A_plus - B_plus * x, -B_plus};
+    if (theta < -transition) return {A_minus - B_minus * x, -B_minus};
     const double r3 = std::sqrt(3.0);
     const double K = std::cos(theta) - sin_angle * std::sin(theta) / r3;
     const double dKdtheta = -std::sin(theta) - sin_angle * std::cos(theta) / r3;
-    return {K, dKdtheta / (3.0 * std::cos(3.0 * theta))};  // cos(3 theta) >= cos(87 deg) here
+    return {K, dKdtheta / (3.0 * std::cos(3.0 * theta))};  // cos(3 theta) >= cos(3 theta_T) > 0 here
   }
 };
 
@@ -65,8 +75,11 @@ struct MohrCoulombSurface {
   double round_F = 0.0;  // eps sin(phi): delta_F = round_F * Y
   double round_Q = 0.0;  // eps sin(psi)
 
-  static MohrCoulombSurface make(double phi, double psi, double eps) {
-    return {LodeFactor::of(std::sin(phi)), LodeFactor::of(std::sin(psi)), eps * std::sin(phi), eps * std::sin(psi)};
+  /// theta_T in radians, in [kMinTransitionDegrees, kMaxTransitionDegrees] degrees.
+  static MohrCoulombSurface make(double phi, double psi, double eps,
+                                 double transition = LodeFactor::kDefaultTransition) {
+    return {LodeFactor::of(std::sin(phi), transition), LodeFactor::of(std::sin(psi), transition), eps * std::sin(phi),
+            eps * std::sin(psi)};
   }
 
   /// F of eq. (1.11.1), Pa.

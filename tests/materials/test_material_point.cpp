@@ -110,6 +110,15 @@ TEST(MaterialPointCase, BadDruckerPragerInputNamesKeyAndFile) {
   expect_input_error("mp_dp_res.toml", dp + good + "residual_cohesion = 2e4\n" + rest, "material.residual_cohesion",
                      "(0, 10000]");
   expect_input_error("mp_dp_typo.toml", dp + good + "dilatency = 5\n" + rest, "material.dilatency", "unknown key");
+  // The tension cut-off (method-notes §1.12): in [0, c cot(phi)] = [0, 17320.5] Pa here.
+  EXPECT_NO_THROW(load_material_point_case(write_case("mp_dp_t.toml", dp + good + "tension_cutoff = 0\n" + rest), {}));
+  expect_input_error("mp_dp_tneg.toml", dp + good + "tension_cutoff = -1\n" + rest, "material.tension_cutoff",
+                     "largest mean stress");
+  expect_input_error("mp_dp_tapex.toml", dp + good + "tension_cutoff = 1.8e4\n" + rest, "material.tension_cutoff",
+                     "c cot(phi)");
+  // lode_transition belongs to Mohr-Coulomb only.
+  expect_input_error("mp_dp_lode.toml", dp + good + "lode_transition = 29\n" + rest, "material.lode_transition",
+                     "unknown key");
 }
 
 TEST(MaterialPointCase, BadMohrCoulombInputNamesKeyAndFile) {
@@ -126,6 +135,20 @@ TEST(MaterialPointCase, BadMohrCoulombInputNamesKeyAndFile) {
                      "the friction angle");
   // dp_match belongs to Drucker-Prager only.
   expect_input_error("mp_mc_match.toml", mc + good + "dp_match = 'outer'\n" + rest, "material.dp_match", "unknown key");
+  // theta_T in [20, 29.9] degrees (method-notes §1.11); the cut-off as for Drucker-Prager, any
+  // T >= 0 without friction (no apex).
+  EXPECT_NO_THROW(
+      load_material_point_case(write_case("mp_mc_lode.toml", mc + good + "lode_transition = 29.9\n" + rest), {}));
+  expect_input_error("mp_mc_lode30.toml", mc + good + "lode_transition = 30\n" + rest, "material.lode_transition",
+                     "[20, 29.9]");
+  expect_input_error("mp_mc_lode19.toml", mc + good + "lode_transition = 19\n" + rest, "material.lode_transition",
+                     "[20, 29.9]");
+  expect_input_error("mp_mc_tapex.toml", mc + good + "tension_cutoff = 1e5\n" + rest, "material.tension_cutoff",
+                     "c cot(phi)");
+  EXPECT_NO_THROW(load_material_point_case(
+      write_case("mp_mc_t0.toml", mc + "cohesion = 1e4\nfriction_angle = 0\ntension_cutoff = 1e6\n" + rest), {}));
+  expect_input_error("mp_mc_t0neg.toml", mc + "cohesion = 1e4\nfriction_angle = 0\ntension_cutoff = -5\n" + rest,
+                     "material.tension_cutoff", ">= 0 Pa");
 }
 
 // Pressure-dependent Cam-Clay elasticity (method-notes eq. (1.8.8)): its keys and their errors.
@@ -222,9 +245,10 @@ TEST(MaterialPointCase, RunWritesCsvWithTheDocumentedHeader) {
 }
 
 TEST(MaterialPointCase, ExampleCasesLoad) {
-  for (const char* name : {"von_mises_shear.toml", "cam_clay_drained_nc.toml", "cam_clay_undrained_nc.toml",
-                           "cam_clay_case3_biaxial.toml", "drucker_prager_plane_strain.toml",
-                           "mohr_coulomb_triaxial.toml", "cam_clay_undrained_pressure_dependent.toml"}) {
+  for (const char* name :
+       {"von_mises_shear.toml", "cam_clay_drained_nc.toml", "cam_clay_undrained_nc.toml", "cam_clay_case3_biaxial.toml",
+        "drucker_prager_plane_strain.toml", "mohr_coulomb_triaxial.toml", "cam_clay_undrained_pressure_dependent.toml",
+        "mohr_coulomb_tension_cutoff.toml"}) {
     const std::string f = std::string(RKTSPH_SOURCE_DIR) + "/cases/material_point/" + name;
     EXPECT_NO_THROW(load_material_point_case(f, {})) << name;
   }

@@ -656,8 +656,9 @@ TEST(MohrCoulombPerzyna, FastLimitTriaxialPeaks) {
       "[ figures  ] Mohr-Coulomb triaxial peaks: worst error to the rounded closed form %.2e; to the sharp "
       "pyramid %.2e (compression), %.2e (extension)\n",
       worst_rounded, sharp_error[0], sharp_error[1]);
-  // theta_T = 29 deg rounds the corners: the compression peak is 1.5 % below the sharp one at phi = 30.
-  EXPECT_LT(sharp_error[0], 2e-2);
+  // theta_T = 29.7 deg rounds the corners: the compression peak is 0.45 % below the sharp one at
+  // phi = 30 (eq. (1.11.8); 1.5 % with the former 29 deg).
+  EXPECT_LT(sharp_error[0], 6e-3);
   EXPECT_LT(sharp_error[1], 3e-3);
 }
 
@@ -693,6 +694,83 @@ TEST(MohrCoulombPerzyna, WithoutFrictionShearsLikeVonMises) {
   }
   EXPECT_NEAR(a.points.back().state[0], b.points.back().state[0], 1e-12);
   EXPECT_GT(a.points.back().state[0], 1e-3);  // it did flow
+}
+
+// Tension cut-off (method-notes §1.12). Isotropic extension at eps_dot per normal component,
+// psi = 0: beyond the apex the shear surface has no flow on the axis, so without a cut-off
+// the mean stress grows elastically; with one it settles where the cut-off's viscoplastic
+// volumetric rate takes all of 3 eps_dot: sigma_m = T + Y 3 eps_dot/gamma (Phi = x), which
+// tends to the rate-independent return sigma_m = T as gamma grows.
+TEST(TensionCutoff, IsotropicTensionIsRelievedToTheCutoff) {
+  const double T = 5e3, rate = 0.01, K = 1e8 / (3 * (1 - 2 * 0.3));
+  LoadPath path;
+  path.rate = {rate, rate, rate, 0, 0, 0};
+  path.duration = 0.2;
+  path.dt = 1e-3;
+  const std::string dp = drucker_prager("plane_strain", 30.0, 0.0, 20.0);
+  const std::string mc0 = mohr_coulomb(0.0, 0.0, 20.0), mc30 = mohr_coulomb(30.0, 0.0, 20.0);
+  // Without the key nothing relieves the isotropic tension (the behaviour kept by default).
+  const PathResult free = integrate_path(*material_from_toml(mc30), {}, path);
+  EXPECT_NEAR(free.points.back().stress[0], 3 * K * rate * 0.2, 1e-6 * K);
+  struct Model {
+    std::string toml;
+    double Y;  // xi c
+  };
+  const double sf = std::sin(30 * kDegree), cf = std::cos(30 * kDegree), sp = 0.0;
+  const double xi_dp = 3 * cf * std::sqrt(3 + sp * sp) / (3 + sf * sp);
+  for (const Model& model :
+       {Model{dp, xi_dp * 1e4}, Model{mc30, std::sqrt(3.0) * cf * 1e4}, Model{mc0, std::sqrt(3.0) * 1e4}}) {
+    double excess[2];
+    const double gammas[2] = {20.0, 200.0};
+    for (int g = 0; g < 2; ++g) {
+      std::string toml = model.toml;
+      toml.replace(toml.find("fluidity = "), std::string::npos, "fluidity = " + std::to_string(gammas[g]) + "\n");
+      auto m = material_from_toml(toml + "tension_cutoff = 5.0e3\n");
+      const PathResult r = integrate_path(*m, {}, path);
+      const Sym6& e = r.points.back().stress;
+      const double expected = T + model.Y * 3 * rate / gammas[g];
+      for (std::size_t i = 0; i < 3; ++i) EXPECT_NEAR(e[i], expected, 1e-6 * expected) << model.toml << " i " << i;
+      for (std::size_t i = 3; i < 6; ++i) EXPECT_EQ(e[i], 0.0);
+      EXPECT_LT(r.points.back().state[0], 1e-12);  // no deviatoric plastic strain
+      excess[g] = (e[0] - T) / T;
+      for (const PathPoint& p : r.points) EXPECT_LE(p.stress[0], 3 * K * rate * 0.2);  // bounded
+    }
+    std::printf("[ figures  ] cut-off excess (sigma_m - T)/T: %.2e (gamma = 20), %.2e (gamma = 200)\n", excess[0],
+                excess[1]);
+    EXPECT_NEAR(excess[0] / excess[1], 10.0, 1e-3);
+  }
+}
+
+// Both mechanisms at once: Mohr–Coulomb, phi = 30, psi = 10, T = 5 kPa in uniaxial-strain
+// extension (eps_yy grows, the others held). The cut-off acts first (sigma_m = T while the
+// shear surface needs about 8 kPa), then q grows along sigma_m = T to the shear surface: the
+// end state sits on the intersection. As gamma grows the state converges (the differences
+// shrink like 1/gamma) to a point that satisfies both surfaces: the rate-independent limit.
+TEST(TensionCutoff, FastLimitOnTheIntersectionOfBothSurfaces) {
+  const double T = 5e3, Y = std::sqrt(3.0) * std::cos(30 * kDegree) * 1e4;
+  LoadPath path = LoadPath::oedometric(0.02);
+  path.duration = 0.1;
+  path.dt = 1e-3;
+  const double gammas[3] = {2.0, 20.0, 200.0};
+  Sym6 end[3];
+  for (int g = 0; g < 3; ++g) {
+    std::string toml = mohr_coulomb(30.0, 10.0, gammas[g]) + "tension_cutoff = 5.0e3\n";
+    auto m = material_from_toml(toml);
+    const PathResult r = integrate_path(*m, {}, path);
+    end[g] = r.points.back().stress;
+    EXPECT_TRUE(std::all_of(end[g].begin(), end[g].end(), [](double v) { return std::isfinite(v); }));
+    const MohrCoulombSurface surf = MohrCoulombSurface::make(30 * kDegree, 10 * kDegree, 0.1);
+    const double x = (surf.value(end[g], Y) - Y) / Y, x_t = (tensor::trace(end[g]) / 3 - T) / Y;
+    std::printf("[ figures  ] gamma = %5.0f: shear overstress %.2e, cut-off overstress %.2e, sigma_yy %.1f Pa\n",
+                gammas[g], x, x_t, end[g][1]);
+    EXPECT_GT(x, 0.0);  // both act
+    EXPECT_GT(x_t, 0.0);
+    EXPECT_LT(x, 0.5 / gammas[g]);
+    EXPECT_LT(x_t, 0.5 / gammas[g]);
+  }
+  const double d1 = std::abs(end[0][1] - end[1][1]), d2 = std::abs(end[1][1] - end[2][1]);
+  EXPECT_GT(d1 / d2, 7.0);
+  EXPECT_LT(d1 / d2, 13.0);
 }
 
 }  // namespace
