@@ -71,6 +71,7 @@ def main():
     ap.add_argument("--rktsph", default="build/rktsph")
     ap.add_argument("--threads", type=int, default=1)
     ap.add_argument("--set", action="append", default=[], help="extra --set key=value for the run")
+    ap.add_argument("--row-depth", type=float, help="depth of the section row below the footing (m); default B/2")
     ap.add_argument("--no-run", action="store_true", help="only read an existing output folder")
     ap.add_argument("--low", type=float, default=-0.03, help="lower tolerance on the error (default -0.03)")
     ap.add_argument("--high", type=float, default=0.08, help="upper tolerance on the error (default +0.08)")
@@ -97,7 +98,7 @@ def main():
     name = os.path.splitext(os.path.basename(args.case))[0]
     out = args.out or os.path.join("out", name if args.spacing is None else f"{name}-dx{dx:g}")
 
-    row_y = top - b
+    row_y = top - (args.row_depth if args.row_depth is not None else b)
     n_row = int(round(width / dx)) + 1
     n_nodes = int(round(b / dx)) + 1
     if abs((n_nodes - 1) * dx - b) > 1e-9 * b:

@@ -34,13 +34,3 @@ add_test(NAME fos_quick
                  --out ${CMAKE_BINARY_DIR}/test-out/fos_quick --scale 3.4 --low 3.64 --high 4.00
                  -- --set geometry.spacing=0.5 --tol 0.02 --jobs 2 --threads 2 --quiet)
 set_tests_properties(fos_quick PROPERTIES LABELS validation PROCESSORS 2 TIMEOUT 600)
-
-# Smooth rigid strip footing on weightless c-phi soil (phi = psi = 20 deg, c = q_s = 10 kPa,
-# cases/examples/strip_footing_cphi20_2d.toml) at the coarse spacing B/10: the plateau of the
-# section pressure must lie within -3/+8 % of Prandtl-Reissner's q_u = 212.34 kPa
-# (docs/VALIDATION.md, "Bearing capacity of c-phi soil"). About 40 s of one core.
-add_test(NAME footing_cphi20_quick
-         COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/scripts/check_footing_cphi.py
-                 ${PROJECT_SOURCE_DIR}/cases/examples/strip_footing_cphi20_2d.toml --spacing 0.2
-                 --rktsph $<TARGET_FILE:rktsph> --out ${CMAKE_BINARY_DIR}/test-out/footing_cphi20_quick --no-plot)
-set_tests_properties(footing_cphi20_quick PROPERTIES LABELS validation TIMEOUT 600)
