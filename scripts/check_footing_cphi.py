@@ -18,7 +18,7 @@ effect, then reads probes.csv:
   over their segments (dx/2 at the centre and at the edge, whose other half is under the cover);
 * settlement s = -u_y of the centre node (all footing nodes move together);
 * plateau: the mean of q over the last quarter of the settlement (s >= 0.75 s_end); its
-  flatness is reported as the change of q across that window relative to q_u.
+  flatness is reported as the change of q across that window relative to q_u and its range.
 
 It prints the plateau, the exact value and the error, draws q/q_u against s/B
 (footing_cphi.png in the output folder), and exits with status 1 when the error is outside
@@ -163,7 +163,8 @@ def main():
     print(f"plateau (mean q over s >= 0.75 s_end, {len(window)} rows) = {plateau / 1e3:.2f} kPa; "
           f"exact q_u = {q_u / 1e3:.2f} kPa; error {100 * error:+.2f} % "
           f"(tolerance {100 * args.low:+.0f}/{100 * args.high:+.0f} %); "
-          f"change across the window {100 * drift:+.2f} % of q_u")
+          f"change across the window {100 * drift:+.2f} % of q_u, range "
+          f"{min(q for _, q in window) / q_u:.3f}-{max(q for _, q in window) / q_u:.3f} q_u")
     print(f"footing nodes' own sigma_yy over the same window: {plateau_nodes / 1e3:.2f} kPa, "
           f"{100 * (plateau_nodes / q_u - 1):+.2f} %")
     ok = args.low <= error <= args.high
