@@ -7,8 +7,8 @@
 #
 # Runs the two benchmark binaries alternately, REPS times each (old, new, old, new, ...), every
 # run with
-#   --benchmark_filter='^BM_V1Step/100000/[12]/real_time$|^BM_V3Step/100000/[12]/1/real_time$'
-# (BM_V1Step/nodes/threads and BM_V3Step/nodes/threads/filter of bench/bench_step.cpp: the V1
+#   --benchmark_filter='^BM_V1Step/100000/[12]/real_time$|^BM_V3Step/100000/[12]/1/0/real_time$'
+# (BM_V1Step/nodes/threads and BM_V3Step/nodes/threads/filter/implicit_faces of bench/bench_step.cpp: the V1
 # step and the V3 step with the pressure filter, 1e5 nodes, 1 and 2 threads), so slow drifts of
 # the machine hit both binaries alike. Override the filter with BENCH_FILTER=regex; arguments
 # after `--` go to every run (e.g. -- --benchmark_min_time=2
@@ -50,7 +50,7 @@ case $REPS in '' | *[!0-9]* | 0) echo "REPS must be a positive integer, not '$RE
 for b in "$OLD" "$NEW"; do
   [ -x "$b" ] || { echo "not an executable: $b" >&2; exit 2; }
 done
-FILTER=${BENCH_FILTER:-'^BM_V1Step/100000/[12]/real_time$|^BM_V3Step/100000/[12]/1/real_time$'}
+FILTER=${BENCH_FILTER:-'^BM_V1Step/100000/[12]/real_time$|^BM_V3Step/100000/[12]/1/0/real_time$'}
 
 here=$(cd "$(dirname "$0")" && pwd)
 repo=$(dirname "$here")

@@ -93,18 +93,16 @@ FacePressureCoupling<Dim> build_face_pressure_coupling(const StaggeredModel<Dim>
   }
 
   // A = S_w D B: the pressure step's node divergence of the velocity response.
-  std::vector<std::vector<std::pair<Index, double>>> by_node(static_cast<std::size_t>(nn));  // (entry index)
-  for (std::size_t n = 0; n < out.entries.size(); ++n)
-    by_node[static_cast<std::size_t>(out.entries[n].node)].emplace_back(static_cast<Index>(n), 0.0);
+  std::vector<std::vector<std::size_t>> by_node(static_cast<std::size_t>(nn));  // entries of B per node
+  for (std::size_t n = 0; n < out.entries.size(); ++n) by_node[static_cast<std::size_t>(out.entries[n].node)].push_back(n);
   using Triplet = Eigen::Triplet<double>;
   std::vector<Triplet> a;
   for (Index j = 0; j < nn; ++j) {
     const auto r = node_operator.row(j);
     for (Index q = r.begin; q < r.end; ++q) {
       const Index i = node_operator.source(r, q);
-      for (const auto& [n, unused] : by_node[static_cast<std::size_t>(i)]) {
-        (void)unused;
-        const auto& e = out.entries[static_cast<std::size_t>(n)];
+      for (const std::size_t n : by_node[static_cast<std::size_t>(i)]) {
+        const auto& e = out.entries[n];
         const double g = node_operator.grad[static_cast<std::size_t>(q)][static_cast<std::size_t>(e.axis)];
         a.emplace_back(j, out.face_node[static_cast<std::size_t>(e.coupling)], saturation * g * e.value);
       }

@@ -90,7 +90,7 @@ PorePressureStage<Dim>::PorePressureStage(StaggeredModel<Dim>& model) : m_(model
   // The implicit face condition (method-notes eq. (2.4.16)); with the stress points' divergence
   // the storage equation reads the half-step velocity, which the coupling does not model. By
   // default only where the explicit form nears its limit: below, it is stable, and the
-  // symmetric K keeps the conjugate gradient (BiCGSTAB costs 30 % more per step).
+  // symmetric K keeps the conjugate gradient (BiCGSTAB costs 30-50 % more per step, BM_V3Step).
   using Faces = FluidSpec::FaceCondition;
   const bool implicit_faces =
       fl.face_condition == Faces::implicit ||
