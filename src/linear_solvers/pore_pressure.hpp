@@ -8,8 +8,9 @@
 // the rest, k_eff (L - S) p^n, is deferred to the right-hand side (method-notes §3.5, §6 item 8).
 // Drained nodes (p prescribed) are eliminated symmetrically: their rows and columns leave K and
 // the known values move to the right-hand side. K and its preconditioner are built once (the
-// particles do not move and dt is fixed); each step is one Eigen::ConjugateGradient solve
-// started from p^n. Nothing here is a hand-written Krylov method.
+// particles do not move and dt is fixed), stored by shared row patterns (pattern_matrix.hpp);
+// each step is one Eigen::ConjugateGradient solve, matrix-free over that storage, started from
+// an extrapolation of p^n. Nothing here is a hand-written Krylov method.
 #include <memory>
 #include <span>
 #include <string>
@@ -18,6 +19,7 @@
 #include <Eigen/SparseCore>
 
 #include "core/types.hpp"
+#include "linear_solvers/pattern_matrix.hpp"
 
 namespace rktsph {
 
@@ -64,6 +66,10 @@ class PorePressureSolver {
   PorePressureSolver(const Sparse& full, const Sparse& symmetric, const std::vector<bool>& dirichlet,
                      const Settings& settings, const Sparse* filter_symmetric = nullptr,
                      const Sparse* filter_explicit = nullptr, const Sparse* face_coupling = nullptr);
+  /// The same from pattern-stored operators (the V3 stage's set-up; no CSR copy of any of them).
+  PorePressureSolver(const PatternMatrix& full, const PatternMatrix& symmetric, const std::vector<bool>& dirichlet,
+                     const Settings& settings, const PatternMatrix* filter_symmetric = nullptr,
+                     const PatternMatrix* filter_explicit = nullptr, const Sparse* face_coupling = nullptr);
   ~PorePressureSolver();
   PorePressureSolver(const PorePressureSolver&) = delete;
   PorePressureSolver& operator=(const PorePressureSolver&) = delete;
@@ -84,12 +90,20 @@ class PorePressureSolver {
   WarmStart warm_start() const;
   void set_warm_start(const WarmStart& w);
   Index unknowns() const { return static_cast<Index>(free_.size()); }
-  /// K restricted to the free (non-drained) nodes (tests: symmetry, definiteness).
-  const Sparse& matrix() const;
+  /// The system matrix on the free (non-drained) nodes: K, or K + A with the implicit face
+  /// coupling (tests: symmetry, definiteness).
+  Sparse matrix() const;
+  /// Memory held: the matrices and the solver's vectors, bytes.
+  std::size_t bytes() const;
+  /// Shared row patterns of the system matrix and of the right-hand-side operator.
+  Index matrix_patterns() const;
+  Index rhs_patterns() const;
   /// True when the implicit face coupling is in the matrix (BiCGSTAB instead of CG).
   bool coupled() const;
 
  private:
+  void build(const PatternMatrix& full, const PatternMatrix& symmetric, const std::vector<bool>& dirichlet,
+             const PatternMatrix* filter_symmetric, const PatternMatrix* filter_explicit, const Sparse* face_coupling);
   struct Impl;
   std::unique_ptr<Impl> impl_;
   std::vector<Index> free_;   // free node of each unknown

@@ -37,6 +37,11 @@ struct FacePressureCoupling {
   Sparse storage_matrix;
 
   bool empty() const { return face_node.empty(); }
+  std::size_t bytes() const {
+    return face_node.size() * sizeof(Index) + entries.size() * sizeof(Entry) +
+           static_cast<std::size_t>(storage_matrix.nonZeros()) * (sizeof(double) + sizeof(int)) +
+           static_cast<std::size_t>(storage_matrix.outerSize() + 1) * sizeof(int);
+  }
   /// v += B (p_new - p_old).
   void add_velocity(FieldView<double, Dim> v, const double* p_new, const double* p_old) const;
 };

@@ -62,8 +62,11 @@ PorePressureStage<Dim>::PorePressureStage(StaggeredModel<Dim>& model) : m_(model
   relation.build(nodes.position, nodes.position, operator_relation_options(m_.kernel), m_.policy);
   node_operator_ = build_corrected_operator<Dim>(relation, nodes.position, nodes, m_.kernel);
   relation.build(nodes.position, nodes.position, laplacian_relation_options(m_.kernel), m_.policy);
-  const NodeLaplacian<Dim> lap =
-      build_node_laplacian<Dim>(relation, nodes, m_.kernel, {}, conditions_.planes, conditions_.mirror_mask);
+  // The operators of the pressure system are built row by row into shared-pattern storage
+  // (linear_solvers/pattern_matrix.hpp): no CSR copy of any of them at any time, so the set-up
+  // peaks at a few hundred bytes per node above the V1 state (method-notes §5.3 "Storage").
+  const NodeLaplacianPatterns lap =
+      build_node_laplacian_patterns<Dim>(relation, nodes, m_.kernel, conditions_.planes, conditions_.mirror_mask);
 
   // K = I/(Q* dt) - k_eff S with k_eff = k_w + S_w dt/rho (method-notes §2.4). One mixture density
   // is assumed for the fractional-step term (the densest material: the largest stabilisation is
@@ -107,9 +110,8 @@ PorePressureStage<Dim>::PorePressureStage(StaggeredModel<Dim>& model) : m_(model
     // incremental projection leaves undamped, without acting on the linear (and, inside, the
     // quadratic) pressure fields that loads impose at impermeable walls.
     s.filter = fl.filter * fl.saturation * stabilisation_time_ / rho;
-    const auto grad = gradient_matrices<Dim>(node_operator_, static_cast<Index>(nn));
-    const NodeLaplacian<Dim> plain = build_node_laplacian<Dim>(relation, nodes, m_.kernel);
-    const PorePressureSolver::Sparse tg = build_filter_gradient_part<Dim>(plain.symmetric, nodes.position, grad);
+    const NodeLaplacianPatterns plain = build_node_laplacian_patterns<Dim>(relation, nodes, m_.kernel, {}, {}, false);
+    const PatternMatrix tg = build_filter_gradient_patterns<Dim>(plain.symmetric, nodes.position, node_operator_);
     solver_ =
         std::make_unique<PorePressureSolver>(lap.full, lap.symmetric, conditions_.drained, s, &plain.symmetric, &tg, coupling);
   } else {
@@ -159,7 +161,7 @@ void PorePressureStage<Dim>::load(const io::StateArchive& a, const std::string& 
 template <int Dim>
 std::size_t PorePressureStage<Dim>::scratch_bytes() const {
   return (p_old_.size() + source_.size() + pressure_gradient_.size() + skeleton_.size()) * sizeof(double) +
-         node_operator_.bytes();
+         node_operator_.bytes() + (solver_ != nullptr ? solver_->bytes() : 0) + face_coupling_.bytes();
 }
 
 template <int Dim>
