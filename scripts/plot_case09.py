@@ -23,7 +23,7 @@ def main(d):
     h0, xf = meta["h0"][0], meta["xf"][0]
     fr = read(d / "frames.csv")
     times = sorted(set(fr["t"]))
-    fig, axes = plt.subplots(len(times), 1, figsize=(12, 2.2 * len(times) + 0.5), sharex=True)
+    fig, axes = plt.subplots(len(times), 1, figsize=(12, 2.4 * len(times) + 0.5))
     if len(times) == 1:
         axes = [axes]
     emax = max(fr["eps_vp_eq"]) or 1.0
@@ -44,11 +44,11 @@ def main(d):
         ax.set_title(f"t = {t:.2f} s", fontsize=9)
         ax.set_ylabel("y (m)")
         ax.legend(fontsize=7, loc="upper right")
-        fig.colorbar(sc, ax=ax, label=r"$\bar\varepsilon$ (clipped at 5)", fraction=0.02)
     axes[-1].set_xlabel("x (m)")
-    axes[-1].set_xlim(-0.3, max(30.0, max(fr["x"]) + 0.5))
-    fig.tight_layout()
-    fig.savefig(d / "snapshots.png", dpi=130)
+    for ax in axes:
+        ax.set_xlim(-0.3, max(30.0, max(fr["x"]) + 0.5))
+    fig.colorbar(sc, ax=list(axes), label=r"$\bar\varepsilon$ (clipped at 5)", fraction=0.015, pad=0.01)
+    fig.savefig(d / "snapshots.png", dpi=130, bbox_inches="tight")
 
     p = read(d / "profile.csv")
     fig, ax = plt.subplots(figsize=(11, 3.8))
