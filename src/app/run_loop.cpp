@@ -22,6 +22,7 @@
 #include "io/checkpoint.hpp"
 #include "io/field_catalogue.hpp"
 #include "io/output_files.hpp"
+#include "io/runout.hpp"
 #include "io/vtu_writer.hpp"
 #include "rktsph/version.hpp"
 #include "schemes/pressure_stage.hpp"
@@ -201,8 +202,59 @@ int run_loop(const LoopInput& in) {
     bodies_csv.emplace((out / "bodies.csv").string(), resuming ? in.checkpoint->integer("run/bodies_bytes") : -1);
     if (!resuming) bodies_csv->append(ContactEnforce::csv_header());
   }
+  // runout.csv and deposit.csv (V2 in 2D with rigid bodies, docs/output.md "Run-out measures"):
+  // the deposit's front, heights, particle disorder and mass at every output step, and the
+  // surface profile of the latest one. The base and the first column are the lowest and the
+  // leftmost reference positions (x - u), so a resumed run finds them as a fresh one did.
+  std::optional<io::RowFile> runout_csv;
+  double runout_x0 = 0.0, runout_base = 0.0;
+  if (bodies != nullptr) {
+    // A checkpoint of a build without the file restarts it (-1: an empty file and its header).
+    const bool kept = resuming && in.checkpoint->has("run/runout_bytes");
+    runout_csv.emplace((out / "runout.csv").string(), kept ? in.checkpoint->integer("run/runout_bytes") : -1);
+    if (!kept) {
+      runout_csv->append(
+          "t,front,first_column_height,max_height,detached,surface_nodes,nn_min,nn_mean,nn_max,nn_cv,clustered,"
+          "isolated,mass\n");
+    }
+    const auto u = solver.node_displacement();
+    runout_x0 = runout_base = std::numeric_limits<double>::infinity();
+    for (Index i = 0; i < solver.nodes().size(); ++i) {
+      runout_x0 = std::min(runout_x0, solver.nodes().position[static_cast<std::size_t>(i)][0] - u(i, 0));
+      if constexpr (Dim >= 2) {
+        runout_base = std::min(runout_base, solver.nodes().position[static_cast<std::size_t>(i)][1] - u(i, 1));
+      }
+    }
+  }
+  auto record_runout = [&] {
+    if constexpr (Dim == 2) {
+      if (!runout_csv) return;
+      const auto& set = solver.nodes();
+      const double dx = setup.dx;
+      double xmax = runout_x0, hmax = 0.0, mass = 0.0;
+      for (const auto& p : set.position) xmax = std::max(xmax, p[0]), hmax = std::max(hmax, p[1] - runout_base);
+      for (Index i = 0; i < set.size(); ++i) mass += set.mass(i);
+      for (Index i = 0; i < solver.stress_points().size(); ++i) mass += solver.stress_points().mass(i);
+      const io::DepositProfile p = io::deposit_profile(set.position, runout_x0, xmax + dx, dx, runout_base);
+      const io::Disorder d = io::particle_disorder(set.position, dx);
+      long surface = 0;
+      if (const auto f = set.template find<double, 1>("free_surface"); f.valid()) {
+        for (Index i = 0; i < set.size(); ++i) surface += set.view(f)(i, 0) != 0.0 ? 1 : 0;
+      }
+      runout_csv->append(fmt::format("{:.10g},{:.10g},{:.10g},{:.10g},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{},{},{:.15g}\n",
+                                     solver.time(), p.front, p.h.front(), hmax, p.detached, surface, d.min, d.mean,
+                                     d.max, d.cv, d.clustered, d.isolated, mass));
+      std::string profile = fmt::format("# t = {:.10g} s; h above the base y = {:.10g} m\nx,h,count\n", solver.time(),
+                                        runout_base);
+      for (std::size_t k = 0; k < p.h.size(); ++k) {
+        profile += fmt::format("{:.10g},{:.10g},{}\n", p.centre(k), p.h[k], p.count[k]);
+      }
+      io::write_file_atomically((out / "deposit.csv").string(), profile, false);
+    }
+  };
   auto record_bodies = [&] {
     if (bodies_csv) bodies_csv->append(bodies->csv_rows(solver.time()));
+    record_runout();
   };
   io::PvdCollection node_pvd((out / "nodes.pvd").string());
   io::PvdCollection elem_pvd((out / "elements.pvd").string());
@@ -255,6 +307,7 @@ int run_loop(const LoopInput& in) {
     probe_csv.flush();
     energy_csv.flush();
     if (bodies_csv) bodies_csv->flush();
+    if (runout_csv) runout_csv->flush();
   };
   const fs::path checkpoint_file = out / "checkpoint" / "checkpoint.h5";
   auto write_checkpoint = [&](double loop_seconds) {
@@ -279,6 +332,7 @@ int run_loop(const LoopInput& in) {
     a.put_integer("run/probes_bytes", probe_csv.written());
     a.put_integer("run/energy_bytes", energy_csv.written());
     if (bodies_csv) a.put_integer("run/bodies_bytes", bodies_csv->written());
+    if (runout_csv) a.put_integer("run/runout_bytes", runout_csv->written());
     save_entries(a, "run/node_frames", node_pvd.entries());
     save_entries(a, "run/stress_point_frames", elem_pvd.entries());
     fs::create_directories(out / "checkpoint");
