@@ -60,6 +60,20 @@ TEST(PorePressure, MatrixIsSymmetricPositiveDefiniteWithADirichletRow) {
     PorePressureSolver solver(lap.full, lap.symmetric, drained, settings(inv_q_dt, PressurePreconditioner::diagonal));
     EXPECT_EQ(solver.unknowns(), 11 * 8);
     const Eigen::MatrixXd K = Eigen::MatrixXd(solver.matrix());
+    // K = I/(Q dt) - k_eff S on the free nodes (method-notes eq. (2.4.13)); S is symmetric
+    // without mirror walls, so the solver's symmetrisation from the lower triangle changes
+    // nothing and K equals the assembled matrix (to the row patterns' sharing tolerance).
+    const Eigen::MatrixXd S = Eigen::MatrixXd(lap.symmetric);
+    Eigen::MatrixXd expected(solver.unknowns(), solver.unknowns());
+    for (int a = 0, ra = 0; a < S.rows(); ++a) {
+      if (drained[static_cast<std::size_t>(a)]) continue;
+      for (int b = 0, rb = 0; b < S.cols(); ++b) {
+        if (drained[static_cast<std::size_t>(b)]) continue;
+        expected(ra, rb++) = (a == b ? inv_q_dt : 0.0) - 3e-7 * S(a, b);
+      }
+      ++ra;
+    }
+    EXPECT_LT((K - expected).norm(), 1e-12 * K.norm());
     EXPECT_LT((K - K.transpose()).norm(), 1e-14 * K.norm());
     const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(K);
     EXPECT_GT(eig.eigenvalues().minCoeff(), 0.0) << "1/(Q dt) = " << inv_q_dt;
@@ -72,6 +86,31 @@ TEST(PorePressure, MatrixIsSymmetricPositiveDefiniteWithADirichletRow) {
   PorePressureSolver floating(lap.full, lap.symmetric, none, settings(0.0, PressurePreconditioner::diagonal));
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(Eigen::MatrixXd(floating.matrix()));
   EXPECT_LT(std::abs(eig.eigenvalues().minCoeff()), 1e-10 * eig.eigenvalues().maxCoeff());
+}
+
+TEST(PorePressure, AnUnsymmetricAssembledMatrixIsSymmetrisedFromItsLowerTriangle) {
+  // Mirror walls seen by some nodes only (as near a drained corner, method-notes §2.4 "Storage"):
+  // the assembled S, hence K, is unsymmetric; the solver keeps K's lower triangle and mirrors it.
+  const auto s = grid(10, 8, 0.1);
+  const std::vector<MirrorPlane> walls = {{0, 0.0, -1}};
+  std::vector<std::uint8_t> mask(static_cast<std::size_t>(s.size()), 0);
+  for (std::size_t i = 0; i < mask.size(); ++i) mask[i] = s.position[i][1] < 0.35 ? 1 : 0;
+  const auto lap = build_node_laplacian<2>(s, CubicSplineKernel<2>(0.12), {}, walls, mask);
+  const Eigen::MatrixXd S = Eigen::MatrixXd(lap.symmetric);
+  ASSERT_GT((S - S.transpose()).norm(), 1e-3 * S.norm());  // the case this test is about
+  std::vector<bool> drained(static_cast<std::size_t>(s.size()), false);
+  for (std::size_t i = 0; i < drained.size(); ++i) drained[i] = s.position[i][1] > 0.8 - 1e-9;
+  PorePressureSolver solver(lap.full, lap.symmetric, drained, settings(1e-5, PressurePreconditioner::diagonal));
+  const Eigen::MatrixXd K = Eigen::MatrixXd(solver.matrix());
+  EXPECT_LT((K - K.transpose()).norm(), 1e-14 * K.norm());
+  for (int a = 0, ra = 0; a < S.rows(); ++a) {
+    if (drained[static_cast<std::size_t>(a)]) continue;
+    for (int b = 0, rb = 0; b <= a; ++b) {
+      if (drained[static_cast<std::size_t>(b)]) continue;
+      EXPECT_NEAR(K(ra, rb++), (a == b ? 1e-5 : 0.0) - 3e-7 * S(a, b), 1e-12 * K.norm());
+    }
+    ++ra;
+  }
 }
 
 TEST(PorePressure, ConjugateGradientReachesTheRequestedTolerance) {
