@@ -78,6 +78,8 @@ CaseReport validate_case05(const Options& options, const std::string& case_dir);
 CaseReport validate_case06(const Options& options, const std::string& case_dir);
 CaseReport validate_case07(const Options& options, const std::string& case_dir);
 CaseReport validate_case08(const Options& options, const std::string& case_dir);
+CaseReport validate_case11(const Options& options, const std::string& case_dir);
+CaseReport validate_case12(const Options& options, const std::string& case_dir);
 CaseReport validate_case13(const Options& options, const std::string& case_dir);
 CaseReport validate_case14(const Options& options, const std::string& case_dir);
 CaseReport validate_case15(const Options& options, const std::string& case_dir);
