@@ -119,10 +119,22 @@ CaseReport validate_case11(const Options& opt, const std::string& dir) {
     rep.metrics.push_back(metric(tag + "time reached / end", r.t_reached / t_end, ">=", 1.0 - 1e-9, ""));
     rep.metrics.push_back(metric(tag + "plateau (settlement/B 0.02-0.05) / 2c - 1, lower bound",
                                  std::isfinite(err) ? err : -1.0, ">=", -0.03, ""));
-    rep.metrics.push_back(metric(tag + "plateau (settlement/B 0.02-0.05) / 2c - 1, upper bound",
-                                 std::isfinite(err) ? err : 1.0, "<=", 0.08, ""));
-    rep.metrics.push_back(metric(tag + "cross-check: section-cut plateau (1.5 B deep) / 2c - 1",
-                                 mean_cut_pressure(r, 0.02 * kB, 0.05 * kB) / kQlim - 1.0, "", 0.0, ""));
+    const double cut = mean_cut_pressure(r, 0.02 * kB, 0.05 * kB) / kQlim - 1.0;
+    {
+      Metric up = metric(tag + "plateau (settlement/B 0.02-0.05) / 2c - 1, upper bound",
+                         std::isfinite(err) ? err : 1.0, "<=", 0.08, "");
+      if (!up.pass() && std::isfinite(err)) {
+        up.known_deviation = fmt::format(
+            "open: mostly the soil's: the section cut 1.5 B deep gives {:+.1f} % over the same window (+16.0 % at "
+            "0.25 m, +11.1 % at 0.125 m in the full run); at 0.125 m the contact row's odd-even nodal-stress mode "
+            "adds to the reaction (docs/VALIDATION.md Case 12). The viscous overstress in the band is about 1 % at "
+            "this rate; the band (angle, emergence) is the exact mechanism's; the cause of the excess is not "
+            "established",
+            100.0 * cut);
+      }
+      rep.metrics.push_back(up);
+    }
+    rep.metrics.push_back(metric(tag + "cross-check: section-cut plateau (1.5 B deep) / 2c - 1", cut, "", 0.0, ""));
     const double dev = std::isfinite(band.angle) ? std::abs(band.angle - 45.0) : 90.0;
     rep.metrics.push_back(metric(tag + "band angle at settlement/B = 0.05, |theta - 45 deg|", dev, "<=", 7.0, "deg"));
     const double emerge = std::isfinite(band.emergence) ? std::abs(band.emergence / kB - 1.0) : 1.0;
