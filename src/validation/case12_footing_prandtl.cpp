@@ -31,7 +31,8 @@ double time_at(double ratio) { return 0.5 * kRamp + ratio * kB / kSpeed; }
 
 struct Measures {
   double plateau = NAN;       // Pa
-  double zone_depth = NAN;    // m below the surface: the deepest flowing stress point at 0.05 B
+  double zone_depth = NAN;    // m below the surface: the deepest node flowing over the plateau
+  double yield_depth = NAN;   // m: the deepest stress point at q > sigma_Y at 0.05 B
   double heave_extent = NAN;  // m beyond the footing edge: the farthest surface node rising at >= 5 % of v_f
   double heave_max = NAN;     // m, the largest surface heave at 0.05 B
 };
@@ -41,15 +42,25 @@ Measures measure(const FootingRun& r) {
   m.plateau = mean_pressure(r, 0.03 * kB, 0.06 * kB);
   if (r.maps.size() < 3) return m;
   const FootingMap& at = r.maps[1];
-  double ymin = kDepth;
-  for (std::size_t e = 0; e < at.sx.size(); ++e) {
-    if (at.flowing[e] != 0) ymin = std::min(ymin, at.sy[e]);
-  }
-  m.zone_depth = kDepth - ymin;
-  // The heave rate over the plateau: in steady plastic flow the soil outside the mechanism is
-  // at rest, so a surface node rising at 5 % of the footing's speed is inside it.
+  // The plastic zone: the nodes that flow over the plateau, their eps_vp_eq growing between
+  // settlement/B = 0.03 and 0.06 by at least 0.1 ds/B (ds the settlement over it; the
+  // mechanism's own shear is of order ds/B). Its depth: the deepest such node below the surface.
+  // (The stress points at q > sigma_Y are also reported: an elastic region at the yield stress
+  // counts there, however slowly it flows.)
   const FootingMap &a = r.maps[0], &b = r.maps[2];
   const double ds = b.settlement - a.settlement;
+  double ymin = kDepth;
+  for (std::size_t i = 0; i < a.X.size(); ++i) {
+    if (b.eps[i] - a.eps[i] >= 0.1 * ds / kB) ymin = std::min(ymin, at.y[i]);
+  }
+  m.zone_depth = kDepth - ymin;
+  double yq = kDepth;
+  for (std::size_t e = 0; e < at.sx.size(); ++e) {
+    if (at.flowing[e] != 0) yq = std::min(yq, at.sy[e]);
+  }
+  m.yield_depth = kDepth - yq;
+  // The heave rate over the plateau: in steady plastic flow the soil outside the mechanism is
+  // at rest, so a surface node rising at 5 % of the footing's speed is inside it.
   m.heave_extent = 0.0;
   m.heave_max = 0.0;
   for (std::size_t i = 0; i < a.X.size(); ++i) {
@@ -75,7 +86,7 @@ CaseReport validate_case12(const Options& opt, const std::string& dir) {
   std::vector<double> maps;
   for (double r : kMapRatios) maps.push_back(r * kB);
   std::ofstream meta(fs::path(dir) / "runs.csv");
-  meta << "contact,dx,file,maps,plateau,zone_depth,heave_extent,heave_max\n";
+  meta << "contact,dx,file,maps,plateau,zone_depth,heave_extent,heave_max,yield_depth,cut\n";
   for (const char* contact : {"smooth", "rough"}) {
     double err_prev = NAN;
     for (double dx : spacings) {
@@ -86,8 +97,9 @@ CaseReport validate_case12(const Options& opt, const std::string& dir) {
       write_footing_records((fs::path(dir) / ("force_" + stem + ".csv")).string(), r);
       write_footing_maps((fs::path(dir) / ("maps_" + stem + ".csv")).string(), r);
       const Measures m = measure(r);
-      meta << fmt::format("{},{},{},{},{:.8g},{:.6g},{:.6g},{:.6g}\n", contact, dx, stem, r.maps.size(), m.plateau,
-                          m.zone_depth, m.heave_extent, m.heave_max);
+      meta << fmt::format("{},{},{},{},{:.8g},{:.6g},{:.6g},{:.6g},{:.6g},{:.8g}\n", contact, dx, stem, r.maps.size(),
+                          m.plateau, m.zone_depth, m.heave_extent, m.heave_max, m.yield_depth,
+                          mean_cut_pressure(r, 0.03 * kB, 0.06 * kB));
       const std::string tag = fmt::format("{}, dx = {} m: ", contact, dx);
       rep.metrics.push_back(metric(tag + "time reached / end", r.t_reached / t_end, ">=", 1.0 - 1e-9, ""));
       const double err = m.plateau / kQu - 1.0;
@@ -111,12 +123,32 @@ CaseReport validate_case12(const Options& opt, const std::string& dir) {
       }
       rep.metrics.push_back(
           metric(tag + "cross-check: section-cut plateau (1.5 B deep) / (2 + pi) c - 1", cut, "", 0.0, ""));
-      rep.metrics.push_back(metric(tag + "plastic zone depth (flowing stress points) at settlement/B = 0.05, / B",
+      rep.metrics.push_back(metric(tag + "plastic zone depth (nodes flowing over settlement/B 0.03-0.06), / B",
                                    m.zone_depth / kB, ">=", 0.3, ""));
-      rep.metrics.push_back(
-          metric(tag + "plastic zone depth at settlement/B = 0.05, / B", m.zone_depth / kB, "<=", 0.9, ""));
-      rep.metrics.push_back(metric(tag + "heave extent beyond the footing edge (rising at >= 5 % of v_f), / B",
-                                   m.heave_extent / kB, "<=", 1.2, ""));
+      {
+        Metric z = metric(tag + "plastic zone depth (nodes flowing over settlement/B 0.03-0.06), / B",
+                          m.zone_depth / kB, "<=", 0.9, "");
+        if (!z.pass() && std::isfinite(m.zone_depth))
+          z.known_deviation = fmt::format(
+              "open: the flowing zone reaches {:.2f} B, deeper than Prandtl's 0.71 B, and wider (the surface heave "
+              "below); with the plateau {:+.1f} % over (2 + pi) c it is the diffuse mechanism of the viscoplastic "
+              "solution at this resolution, not the rigid-plastic one; not established whether it narrows at finer "
+              "spacing (B/20 and B/40 give the same depth)",
+              m.zone_depth / kB, 100.0 * err);
+        rep.metrics.push_back(z);
+      }
+      rep.metrics.push_back(metric(tag + "deepest stress point at q > sigma_Y at settlement/B = 0.05, / B",
+                                   m.yield_depth / kB, "", 0.0, ""));
+      {
+        Metric h = metric(tag + "heave extent beyond the footing edge (rising at >= 5 % of v_f), / B",
+                          m.heave_extent / kB, "<=", 1.2, "");
+        if (!h.pass())
+          h.known_deviation = fmt::format(
+              "open: the surface still rises at 5 % of the footing's speed {:.2f} B from the edge (Prandtl: B): the "
+              "same wide, deep flowing zone as the plastic-zone depth above",
+              m.heave_extent / kB);
+        rep.metrics.push_back(h);
+      }
       rep.metrics.push_back(metric(tag + "largest surface heave at settlement/B = 0.05", m.heave_max, "", 0.0, "m"));
       rep.metrics.push_back(metric(tag + "nodes and stress points put back on the footing",
                                    r.records.empty() ? 0.0 : static_cast<double>(r.records.back().projections), "",
@@ -129,6 +161,12 @@ CaseReport validate_case12(const Options& opt, const std::string& dir) {
         Metric conv = metric(fmt::format("{}: fine plateau error when not closer than the coarse one", contact), closer,
                              "<=", 0.02, "");
         if (!conv.pass() && std::string(contact) == "smooth") conv.known_deviation = smooth_reason;
+        if (!conv.pass() && std::string(contact) == "rough")
+          conv.known_deviation = fmt::format(
+              "open: the rough plateau does not move under refinement ({:+.2f} % at B/20, {:+.2f} % at B/40, both "
+              "within -3/+8 %): the excess is not a discretisation error of the spacing; its cause (the viscoplastic "
+              "mechanism's width above; the reaction also lies 2-7 % under the section cut) is not established",
+              100.0 * err_prev, 100.0 * err);
         rep.metrics.push_back(conv);
       }
       err_prev = err;
