@@ -1,6 +1,7 @@
 #include "bodies/contact.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <utility>
 
@@ -68,6 +69,7 @@ RigidContact::RigidContact(const std::vector<BodySpec>& specs, std::size_t nodes
   previous_slip_.assign(kMaxContacts * nodes, 0);
   normal_.assign(kMaxContacts * nodes, Vec<2>::Zero());
   in_contact_.assign(nodes, 0);
+  release_snn_.assign(kMaxContacts * nodes, 0.0);
   x_begin_.assign(nodes, Vec<2>::Zero());
   along_.reserve(nodes);
 }
@@ -126,6 +128,43 @@ void RigidContact::select(const std::vector<Vec<2>>& x, ConstFieldView<double, 2
   std::swap(body_, previous_body_);
   std::swap(slip_, previous_slip_);
   const std::size_t nn = x.size();
+  // The normal stress that decides whether a contact node of the last step is released: the
+  // 1-2-1 mean of sigma_nn with its neighbours in its patch (sorted along the body; the mean
+  // of the two at a patch's end), not the node's own. The nodal stress of a row of contact
+  // nodes can carry an odd-even mode, whose tensile half released nodes inside a compressed
+  // patch, one at a time (a rough footing's pressure jumped by 25 % while the node was out;
+  // docs/VALIDATION.md Case 12). A node alone in its patch keeps its own sigma_nn.
+  for (std::size_t b = 0; b < bodies_.size(); ++b) {
+    along_.clear();
+    for (std::size_t i = 0; i < nn; ++i) {
+      for (int k = 0; k < kMaxContacts; ++k) {
+        const std::size_t slot = kMaxContacts * i + static_cast<std::size_t>(k);
+        if (previous_body_[slot] != static_cast<int>(b)) continue;
+        const BodyGap gap = bodies_[b].gap(x[i], state_[b].offset, depth_);
+        const Vec<2>& n = normal_[slot];
+        release_snn_[slot] = n.dot(traction(s[static_cast<Index>(i)], n));
+        if (gap.within) along_.emplace_back(gap.s, slot);
+      }
+    }
+    std::sort(along_.begin(), along_.end());
+    // Own values first (release_snn_ holds them), then the means, from a copy of the neighbours'.
+    double before = 0.0;  // the previous node's own value
+    for (std::size_t j = 0; j < along_.size(); ++j) {
+      const std::size_t slot = along_[j].second;
+      const double own = release_snn_[slot];
+      const bool has_left = j > 0 && along_[j].first - along_[j - 1].first <= adjacent_;
+      const bool has_right = j + 1 < along_.size() && along_[j + 1].first - along_[j].first <= adjacent_;
+      const double right = has_right ? release_snn_[along_[j + 1].second] : 0.0;
+      if (has_left && has_right) {
+        release_snn_[slot] = 0.25 * (before + 2.0 * own + right);
+      } else if (has_left) {
+        release_snn_[slot] = 0.5 * (before + own);
+      } else if (has_right) {
+        release_snn_[slot] = 0.5 * (own + right);
+      }
+      before = own;
+    }
+  }
   for (std::size_t i = 0; i < nn; ++i) {
     int count = 0;
     const std::size_t base = kMaxContacts * i;
@@ -145,7 +184,8 @@ void RigidContact::select(const std::vector<Vec<2>>& x, ConstFieldView<double, 2
       const Vec<2>& n = gap.normal;
       // Separation (method-notes §4.5): a normal stress more tensile than the adhesion releases
       // the node, and keeps a node that touches from joining; bonded contacts never separate.
-      const double snn = n.dot(traction(s[static_cast<Index>(i)], n));
+      const double snn = was >= 0 ? release_snn_[base + static_cast<std::size_t>(was)]
+                                  : n.dot(traction(s[static_cast<Index>(i)], n));
       const bool holds = bonded || snn <= spec.adhesion;
       bool in = false;
       if (was >= 0) {
@@ -283,12 +323,38 @@ void RigidContact::end_step(double dt, std::vector<Vec<2>>& x, FieldView<double,
 void RigidContact::measure(const std::vector<Vec<2>>& x, ConstFieldView<double, 2> v, ConstFieldView<double, NS> s) {
   // The reaction of the soil on each body, F = sum_I sigma_I n A_I (method-notes eq. (4.5.5)):
   // A_I the tributary length along the body, half the distance to each neighbouring contact
-  // node, and at the end of a patch the distance to the body's edge when that lies within a
-  // spacing (the contact ends at the edge, before the next node), else nothing (the soil ends
-  // at the node: as the half segment of a lattice's corner node).
+  // node, and at the end of a patch the distance d to the body's edge (the contact ends at the
+  // edge, before the next node) when d < dx, or when d < 2 dx and the soil goes on past that edge
+  // (a node not in contact with the body lies past it within 2 dx: the patch's last node has slid
+  // inwards, as under a smooth footing whose soil flows out past its edge), else nothing (the
+  // soil ends at the node: as the half segment of a lattice's corner node). The end length d
+  // carries the mean traction of the patch's last two nodes: the nodal stress of a row of
+  // contact nodes can carry an odd-even mode, which the half-spacing sum cancels but an end
+  // weight on one node alone does not (a footing's pressure jumped by 15-25 % as nodes slid
+  // off its edge; docs/VALIDATION.md Case 12).
   power_ = 0.0;
-  auto edge = [&](double d) { return d >= 0.0 && d < dx_ ? d : 0.0; };
+  std::array<bool, 2> beyond{false, false};
+  auto edge = [&](double d, std::size_t end) {
+    return d >= 0.0 && (d < dx_ || (beyond[end] && d < adjacent_)) ? d : 0.0;
+  };
   for (std::size_t b = 0; b < bodies_.size(); ++b) {
+    beyond = {false, false};
+    const BodySpec& spec = bodies_[b].spec();
+    if (spec.shape != BodyShape::plane) {
+      const std::vector<Vec<2>>& p = spec.points;
+      const std::array<Vec<2>, 2> end{p.front() + state_[b].offset, p.back() + state_[b].offset};
+      const std::array<Vec<2>, 2> off{p.front() - p[1], p.back() - p[p.size() - 2]};  // pointing off each edge
+      for (std::size_t i = 0; i < x.size(); ++i) {
+        bool touching = false;
+        for (int k = 0; k < kMaxContacts; ++k)
+          touching = touching || body_[kMaxContacts * i + static_cast<std::size_t>(k)] == static_cast<int>(b);
+        if (touching) continue;
+        for (std::size_t e = 0; e < 2; ++e) {
+          const Vec<2> r = x[i] - end[e];
+          if (r.dot(off[e]) > 0.0 && r.norm() <= adjacent_) beyond[e] = true;
+        }
+      }
+    }
     along_.clear();
     for (std::size_t i = 0; i < x.size(); ++i) {
       if (in_contact_[i] == 0) continue;
@@ -302,19 +368,25 @@ void RigidContact::measure(const std::vector<Vec<2>>& x, ConstFieldView<double, 
     Vec<2> force = Vec<2>::Zero();
     double width = 0.0, power = 0.0;
     const double s0 = bodies_[b].s_begin(), s1 = bodies_[b].s_end();
+    auto node_traction = [&](std::size_t j) {
+      const std::size_t slot = along_[j].second;
+      return traction(s[static_cast<Index>(slot / kMaxContacts)], normal_[slot]);
+    };
     for (std::size_t j = 0; j < along_.size(); ++j) {
       const double sj = along_[j].first;
-      const double left =
-          j > 0 && sj - along_[j - 1].first <= adjacent_ ? 0.5 * (sj - along_[j - 1].first) : edge(sj - s0);
-      const double right = j + 1 < along_.size() && along_[j + 1].first - sj <= adjacent_
-                               ? 0.5 * (along_[j + 1].first - sj)
-                               : edge(s1 - sj);
+      const bool has_left = j > 0 && sj - along_[j - 1].first <= adjacent_;
+      const bool has_right = j + 1 < along_.size() && along_[j + 1].first - sj <= adjacent_;
+      const double left = has_left ? 0.5 * (sj - along_[j - 1].first) : edge(sj - s0, 0U);
+      const double right = has_right ? 0.5 * (along_[j + 1].first - sj) : edge(s1 - sj, 1U);
       const std::size_t slot = along_[j].second;
       const auto i = static_cast<Index>(slot / kMaxContacts);
-      const double area = left + right;
-      const Vec<2> f = area * traction(s[i], normal_[slot]);
+      const Vec<2> t = node_traction(j);
+      Vec<2> f = ((has_left ? left : 0.0) + (has_right ? right : 0.0)) * t;
+      // An end length: the mean traction of this node and its neighbour in the patch (if any).
+      if (!has_left && left > 0.0) f += left * (has_right ? 0.5 * (t + node_traction(j + 1)) : t);
+      if (!has_right && right > 0.0) f += right * (has_left ? 0.5 * (t + node_traction(j - 1)) : t);
       force += f;
-      width += area;
+      width += left + right;
       power -= f.dot(Vec<2>(v(i, 0), v(i, 1)));
     }
     state_[b].force = force;

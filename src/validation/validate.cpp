@@ -34,6 +34,7 @@ int run_validation(const Options& opt) {
       {"01", validate_case01}, {"02", validate_case02}, {"03", validate_case03}, {"04", validate_case04},
       {"05", validate_case05}, {"06", validate_case06}, {"07", validate_case07}, {"08", validate_case08},
       {"09", validate_case09}, {"10", validate_case10},
+      {"11", validate_case11}, {"12", validate_case12},
       {"13", validate_case13}, {"14", validate_case14}, {"15", validate_case15}, {"16", validate_case16},
       {"17", validate_case17},
   };

@@ -80,6 +80,8 @@ CaseReport validate_case07(const Options& options, const std::string& case_dir);
 CaseReport validate_case08(const Options& options, const std::string& case_dir);
 CaseReport validate_case09(const Options& options, const std::string& case_dir);
 CaseReport validate_case10(const Options& options, const std::string& case_dir);
+CaseReport validate_case11(const Options& options, const std::string& case_dir);
+CaseReport validate_case12(const Options& options, const std::string& case_dir);
 CaseReport validate_case13(const Options& options, const std::string& case_dir);
 CaseReport validate_case14(const Options& options, const std::string& case_dir);
 CaseReport validate_case15(const Options& options, const std::string& case_dir);

@@ -307,6 +307,74 @@ TEST(Contact, ReactionWithTributaryLengths) {
   }
 }
 
+// An odd-even mode in the nodal stress of a row of contact nodes (sigma_yy = -p (1 + a (-1)^k),
+// as under a footing in V2) must neither bias the reaction nor release nodes inside the
+// compressed patch: the half-spacing sum cancels the mode, an end length carries the mean of
+// the patch's last two nodes, and a release is decided on the 1-2-1 mean of sigma_nn along the
+// patch. A patch ending between dx and 2 dx short of the footing's edge reaches the edge only
+// where the soil goes on past it (docs/VALIDATION.md Case 12).
+TEST(Contact, OddEvenNodalStressNeitherBiasesNorReleasesAFooting) {
+  const double p = 1.0e3, a = 0.5;
+  BodySpec s;
+  s.name = "footing";
+  s.shape = BodyShape::segment;
+  s.points = {Vec<2>(0.85, 1.0), Vec<2>(0.0, 1.0)};  // soil below, edge at x = 0.85
+  s.law = ContactLaw::smooth;
+  auto row = [&](int last, bool beyond) {
+    std::vector<Vec<2>> x;
+    for (int k = 0; k <= last; ++k) x.emplace_back(k * kDx, 1.0);
+    if (beyond) x.emplace_back(0.92, 1.0);  // past the edge: the soil goes on
+    Nodes n(x);
+    for (int k = 0; k <= last; ++k) n.s[4 * static_cast<std::size_t>(k) + 1] = -p * (1.0 + a * ((k % 2) ? -1.0 : 1.0));
+    return n;
+  };
+  auto measure = [&](Nodes& n) {
+    RigidContact contact({s}, n.x.size(), 0, kDx, unit_function);
+    const auto nn = static_cast<Index>(n.x.size());
+    contact.select_now(0.0, n.x, ConstFieldView<double, 2>(n.v.data(), nn, 2),
+                       ConstFieldView<double, 4>(n.s.data(), nn, 4));
+    return contact.state()[0];
+  };
+  {
+    // Nodes 0 ... 0.8 touch it, the last 0.05 short of the edge: F = p * 0.85 (the node alone at
+    // the end would have carried 0.05 * 1.5 p there, 3 % too much).
+    Nodes n = row(8, false);
+    const BodyState st = measure(n);
+    EXPECT_EQ(st.contact_nodes, 9);
+    EXPECT_NEAR(st.width, 0.85, 1e-14);
+    EXPECT_NEAR(st.force[1], p * 0.85, 1e-9);
+  }
+  {
+    // The last contact node 0.15 short of the edge (it slid inwards) with soil past the edge: the
+    // patch reaches the edge; without soil there it ends at the node.
+    Nodes n = row(7, true);
+    BodyState st = measure(n);
+    EXPECT_EQ(st.contact_nodes, 8);
+    EXPECT_NEAR(st.width, 0.85, 1e-14);
+    EXPECT_NEAR(st.force[1], p * 0.85, 1e-9);
+    Nodes m = row(7, false);
+    st = measure(m);
+    EXPECT_NEAR(st.width, 0.7, 1e-14);
+    EXPECT_NEAR(st.force[1], p * 0.7, 1e-9);
+  }
+  {
+    // One node's sigma_yy of the mode turns tensile (+0.2 p between neighbours at -1.6 p): kept,
+    // the patch is compressed; the whole row in tension: every node released.
+    Nodes n = row(8, false);
+    RigidContact contact({s}, n.x.size(), 0, kDx, unit_function);
+    n.begin(contact, 0.0, 1e-3);
+    for (std::size_t k = 0; k <= 8; ++k) ASSERT_EQ(contact.in_contact()[k], 1);
+    for (std::size_t k = 0; k <= 8; ++k) n.s[4 * k + 1] = k % 2 ? 0.2 * p : -1.6 * p;
+    n.end(contact, 1e-3);
+    n.begin(contact, 1e-3, 1e-3);
+    for (std::size_t k = 0; k <= 8; ++k) EXPECT_EQ(contact.in_contact()[k], 1) << "node " << k;
+    for (std::size_t k = 0; k <= 8; ++k) n.s[4 * k + 1] = k % 2 ? 2.0 * p : 0.5 * p;
+    n.end(contact, 1e-3);
+    n.begin(contact, 2e-3, 1e-3);
+    for (std::size_t k = 0; k <= 8; ++k) EXPECT_EQ(contact.in_contact()[k], 0) << "node " << k;
+  }
+}
+
 // Load control: a force-driven body accelerates by (F_applied + F_reaction) / M.
 TEST(Contact, ForceDrivenBodyFollowsItsForceBalance) {
   BodySpec spec = plane(Vec<2>(0.0, 1.0), Vec<2>(0.0, -1.0), ContactLaw::smooth);
