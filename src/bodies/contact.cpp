@@ -134,7 +134,11 @@ void RigidContact::select(const std::vector<Vec<2>>& x, ConstFieldView<double, 2
   // nodes can carry an odd-even mode, whose tensile half released nodes inside a compressed
   // patch, one at a time (a rough footing's pressure jumped by 25 % while the node was out;
   // docs/VALIDATION.md Case 12). A node alone in its patch keeps its own sigma_nn.
+  // Only for bodies with release = "patch": on a fixed base under a flowing slide the mean keeps
+  // nodes at a patch's end attached that their own tension would release, and thesis Cases 9
+  // and 10 went unstable earlier with it (docs/VALIDATION.md).
   for (std::size_t b = 0; b < bodies_.size(); ++b) {
+    if (!bodies_[b].spec().release_on_patch_mean) continue;
     along_.clear();
     for (std::size_t i = 0; i < nn; ++i) {
       for (int k = 0; k < kMaxContacts; ++k) {
@@ -184,8 +188,8 @@ void RigidContact::select(const std::vector<Vec<2>>& x, ConstFieldView<double, 2
       const Vec<2>& n = gap.normal;
       // Separation (method-notes §4.5): a normal stress more tensile than the adhesion releases
       // the node, and keeps a node that touches from joining; bonded contacts never separate.
-      const double snn = was >= 0 ? release_snn_[base + static_cast<std::size_t>(was)]
-                                  : n.dot(traction(s[static_cast<Index>(i)], n));
+      const double snn = was >= 0 && spec.release_on_patch_mean ? release_snn_[base + static_cast<std::size_t>(was)]
+                                                                : n.dot(traction(s[static_cast<Index>(i)], n));
       const bool holds = bonded || snn <= spec.adhesion;
       bool in = false;
       if (was >= 0) {

@@ -29,6 +29,9 @@ struct BodySpec {
   ContactLaw law = ContactLaw::rough;
   double friction = 0.0;  // Coulomb mu >= 0
   double adhesion = 0.0;  // Pa: the shear strength at zero normal stress, and the tension a contact bears
+  /// Release on the 1-2-1 patch mean of sigma_nn (`release = "patch"`) rather than the node's
+  /// own (`"node"`, the default): method-notes §4.5, "Separation".
+  bool release_on_patch_mean = false;
   /// Per axis: the velocity value * function(t) (prescribed), or, where force_driven is set,
   /// the applied force value * function(t) in N/m (2D: per unit thickness).
   std::array<double, 2> velocity{0.0, 0.0};

@@ -88,6 +88,11 @@ BodySpec read_body(const io::Section& b, const CaseSetup<2>& c, std::size_t inde
   }
   spec.adhesion = b.number("adhesion", 0.0);
   if (!(spec.adhesion >= 0.0)) b.fail("adhesion", fmt::format("must be >= 0 Pa, got {}", spec.adhesion));
+  const std::string release = b.string("release", "node");
+  if (release == "patch")
+    spec.release_on_patch_mean = true;
+  else if (release != "node")
+    b.fail("release", fmt::format("unknown release rule '{}' (known: node, patch)", release));
 
   std::array<bool, 2> prescribed{false, false};
   if (auto v = b.optional_table("velocity")) {

@@ -320,6 +320,7 @@ TEST(Contact, OddEvenNodalStressNeitherBiasesNorReleasesAFooting) {
   s.shape = BodyShape::segment;
   s.points = {Vec<2>(0.85, 1.0), Vec<2>(0.0, 1.0)};  // soil below, edge at x = 0.85
   s.law = ContactLaw::smooth;
+  s.release_on_patch_mean = true;
   auto row = [&](int last, bool beyond) {
     std::vector<Vec<2>> x;
     for (int k = 0; k <= last; ++k) x.emplace_back(k * kDx, 1.0);

@@ -326,6 +326,8 @@ TEST(RigidBodies, CaseFileErrorsNameFileLineAndKey) {
        "key 'body[1].segment.b': coincides with a"},
       {"contact = \"rough\"", "contact = \"rough\"\nfriction = 0.2",
        "key 'body[1].friction': a friction coefficient needs"},
+      {"contact = \"smooth\"", "contact = \"smooth\"\nrelease = \"mean\"",
+       "key 'body[2].release': unknown release rule 'mean'"},
   };
   for (const Bad& b : bad) {
     std::string text = kBodyCase;
