@@ -8,6 +8,7 @@
 #include <random>
 #include <vector>
 
+#include "../support/node_lattice.hpp"
 #include "core/error.hpp"
 #include "core/kernel.hpp"
 #include "linear_solvers/pattern_matrix.hpp"
@@ -18,19 +19,7 @@ namespace {
 
 using Sparse = PatternMatrix::Sparse;
 
-ParticleSet<2> lattice(int n, int m, double dx) {
-  ParticleSet<2> s;
-  for (int j = 0; j <= m; ++j) {
-    for (int i = 0; i <= n; ++i) {
-      s.position.emplace_back(i * dx, j * dx);
-      const double fx = (i == 0 || i == n) ? 0.5 : 1.0, fy = (j == 0 || j == m) ? 0.5 : 1.0;
-      s.volume.push_back(fx * fy * dx * dx);
-      s.density.push_back(1700.0);
-      s.material.push_back(0);
-    }
-  }
-  return s;
-}
+ParticleSet<2> lattice(int n, int m, double dx) { return test::node_lattice(n, m, dx); }
 
 std::vector<double> random_vector(Eigen::Index n, unsigned seed) {
   std::mt19937 gen(seed);

@@ -16,6 +16,7 @@
 #include <Eigen/Dense>
 
 #include "../support/test_util.hpp"
+#include "../support/node_lattice.hpp"
 #include "core/error.hpp"
 #include "core/kernel.hpp"
 #include "linear_solvers/pore_pressure.hpp"
@@ -26,19 +27,7 @@
 namespace rktsph {
 namespace {
 
-ParticleSet<2> grid(int n, int m, double dx) {
-  ParticleSet<2> s;
-  for (int j = 0; j <= m; ++j) {
-    for (int i = 0; i <= n; ++i) {
-      s.position.emplace_back(i * dx, j * dx);
-      const double fx = (i == 0 || i == n) ? 0.5 : 1.0, fy = (j == 0 || j == m) ? 0.5 : 1.0;
-      s.volume.push_back(fx * fy * dx * dx);
-      s.density.push_back(1700.0);
-      s.material.push_back(0);
-    }
-  }
-  return s;
-}
+ParticleSet<2> grid(int n, int m, double dx) { return test::node_lattice(n, m, dx); }
 
 PorePressureSolver::Settings settings(double inv_q_dt, PressurePreconditioner pc) {
   PorePressureSolver::Settings s;
