@@ -6,8 +6,13 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
+#include <string>
 #include <vector>
 
+#include <fmt/format.h>
+
+#include "core/error.hpp"
 #include "core/types.hpp"
 
 namespace rktsph {
@@ -15,6 +20,10 @@ namespace rktsph {
 template <int Dim>
 class CellList {
  public:
+  /// The largest grid built: kMaxCellsPerPoint cells per point, at least kMaxCellsFloor (64 MiB
+  /// of cell starts); beyond it the constructor throws SolverError.
+  static constexpr double kMaxCellsPerPoint = 64.0;
+  static constexpr std::size_t kMaxCellsFloor = std::size_t{1} << 24;
   /// Cells of side radius / subdivisions; a query scans the (2 subdivisions + 1)^Dim cells
   /// around its own. Finer cells test fewer candidates (2D: 9 r^2 of area with 1, 6.25 r^2 with
   /// 2) for more, shorter ranges.
@@ -78,9 +87,31 @@ CellList<Dim>::CellList(const std::vector<Vec<Dim>>& points, double radius, int 
     lo_ = points.front();
     hi = points.front();
     for (const auto& p : points) {
+      if (!p.allFinite()) {
+        throw SolverError(fmt::format("neighbour search: particle {} has a non-finite position (the run has gone "
+                                      "unstable)",
+                                      &p - points.data()));
+      }
       lo_ = lo_.cwiseMin(p);
       hi = hi.cwiseMax(p);
     }
+  }
+  // A grid far larger than the particle count means particles flung far apart (a run gone
+  // unstable) or non-finite positions: stop with a diagnosis instead of allocating it (or
+  // overflowing the cell counts).
+  const double limit = std::max(static_cast<double>(kMaxCellsFloor), kMaxCellsPerPoint * static_cast<double>(points.size()));
+  double cells = 1.0;
+  for (int d = 0; d < Dim; ++d) {
+    const double along = std::floor((hi[d] - lo_[d]) / side_) + 1.0;
+    cells *= std::isfinite(along) ? std::max(1.0, along) : std::numeric_limits<double>::infinity();
+  }
+  if (!(cells <= limit)) {
+    std::string span;
+    for (int d = 0; d < Dim; ++d) span += fmt::format("{}{:.3g}", d > 0 ? " x " : "", hi[d] - lo_[d]);
+    throw SolverError(fmt::format(
+        "neighbour search: the {} particles span {} m, a cell grid of {:.3g} cells of side {:.3g} m: particles "
+        "have been flung far apart or have non-finite positions (the run has gone unstable)",
+        points.size(), span, cells, side_));
   }
   std::size_t total = 1;
   for (int d = 0; d < Dim; ++d) {

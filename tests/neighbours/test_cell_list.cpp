@@ -54,3 +54,29 @@ TEST(CellList, MatchesBruteForce) {
 
 }  // namespace
 }  // namespace rktsph
+
+namespace rktsph {
+namespace {
+
+// A particle flung far away (a run gone unstable) or a non-finite position stops the search
+// with a diagnosis instead of allocating a grid of astronomical size.
+TEST(CellList, FarFlungOrNonFinitePointsAreASolverError) {
+  std::vector<Vec<2>> points;
+  for (int i = 0; i < 100; ++i) points.emplace_back(0.1 * (i % 10), 0.1 * (i / 10));
+  EXPECT_NO_THROW(CellList<2>(points, 0.24));
+  points.emplace_back(0.0, 1e100);
+  try {
+    CellList<2> cells(points, 0.24);
+    FAIL() << "no error for a point 1e100 m away";
+  } catch (const SolverError& e) {
+    EXPECT_NE(std::string(e.what()).find("flung far apart"), std::string::npos) << e.what();
+  }
+  points.back() = Vec<2>(std::numeric_limits<double>::quiet_NaN(), 0.0);
+  EXPECT_THROW(CellList<2>(points, 0.24), SolverError);
+  // A sparse but sound set: two clusters 1 km apart are within the floor of 2^24 cells.
+  points.back() = Vec<2>(1000.0, 0.0);
+  EXPECT_NO_THROW(CellList<2>(points, 0.24));
+}
+
+}  // namespace
+}  // namespace rktsph
