@@ -231,10 +231,9 @@ int run_loop(const LoopInput& in) {
       if (!runout_csv) return;
       const auto& set = solver.nodes();
       const double dx = setup.dx;
-      double xmax = runout_x0, hmax = 0.0, mass = 0.0;
+      double xmax = runout_x0, hmax = 0.0;
       for (const auto& p : set.position) xmax = std::max(xmax, p[0]), hmax = std::max(hmax, p[1] - runout_base);
-      for (Index i = 0; i < set.size(); ++i) mass += set.mass(i);
-      for (Index i = 0; i < solver.stress_points().size(); ++i) mass += solver.stress_points().mass(i);
+      const double mass = solver.total_mass();
       const io::DepositProfile p = io::deposit_profile(set.position, runout_x0, xmax + dx, dx, runout_base);
       const io::Disorder d = io::particle_disorder(set.position, dx);
       long surface = 0;

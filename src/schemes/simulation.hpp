@@ -60,6 +60,14 @@ class Simulation {
   const CaseSetup<Dim>& setup() const { return model_->setup; }
   const ParticleSet<Dim>& nodes() const { return model_->nodes; }
   const ParticleSet<Dim>& stress_points() const { return model_->stress_points; }
+  /// The mass of both particle sets, kg (2D: per unit thickness); summed nodes first, each set
+  /// in index order (the conservation checks compare it with its value at the start).
+  double total_mass() const {
+    double m = 0.0;
+    for (Index i = 0; i < nodes().size(); ++i) m += nodes().mass(i);
+    for (Index i = 0; i < stress_points().size(); ++i) m += stress_points().mass(i);
+    return m;
+  }
 
   // Typed views of the state (particles/field.hpp).
   VectorView<Dim> node_velocity() const { return VectorView<Dim>(nodes().view(model_->fields.velocity)); }

@@ -96,12 +96,7 @@ BarRun run_bar(const std::string& case_file, double dx) {
   const auto& sps = s.stress_points();
   const auto nn = static_cast<std::size_t>(nodes.size()), ne = static_cast<std::size_t>(sps.size());
   const std::vector<Vec<2>> X = nodes.position, XE = sps.position;
-  auto total_mass = [&] {
-    double m = 0.0;
-    for (Index i = 0; i < nodes.size(); ++i) m += nodes.mass(i);
-    for (Index i = 0; i < sps.size(); ++i) m += sps.mass(i);
-    return m;
-  };
+  auto total_mass = [&] { return s.total_mass(); };
   const double m0 = total_mass();
   // The lattice columns of nodes (by reference X) and the grips.
   std::vector<long> column(nn);

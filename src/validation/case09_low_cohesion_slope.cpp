@@ -76,12 +76,7 @@ SlopeRun run_slope(const std::string& case_file, double dx) {
   const auto& sps = s.stress_points();
   const auto nn = static_cast<std::size_t>(nodes.size());
   const double t_max = s.setup().end_time;
-  auto total_mass = [&] {
-    double m = 0.0;
-    for (Index i = 0; i < nodes.size(); ++i) m += nodes.mass(i);
-    for (Index i = 0; i < sps.size(); ++i) m += sps.mass(i);
-    return m;
-  };
+  auto total_mass = [&] { return s.total_mass(); };
   const double m0 = total_mass();
   const auto* enforce = s.scheme().find<ContactEnforce>();
   if (enforce == nullptr) throw InputError("case 9 needs the rigid base and wall ([[body]] entries)");

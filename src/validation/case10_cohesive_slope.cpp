@@ -72,12 +72,7 @@ Result run_slope(const std::string& file, double dx, const std::vector<std::stri
     }
     return off;
   };
-  auto mass = [](const Simulation<2>& s) {
-    double m = 0.0;
-    for (Index i = 0; i < s.nodes().size(); ++i) m += s.nodes().mass(i);
-    for (Index i = 0; i < s.stress_points().size(); ++i) m += s.stress_points().mass(i);
-    return m;
-  };
+  auto mass = [](const Simulation<2>& s) { return s.total_mass(); };
   const StepHook hook = [&](const Simulation<2>& s) {
     if (m0 == 0.0) m0 = mass(s);
     if (s.time() < next - 1e-9) return;
