@@ -158,7 +158,7 @@ int main(int argc, char** argv) {
   bool val_quick = false;
   auto* val_cmd =
       app.add_subcommand("validate", "Run the thesis cases against their references; write validation/report.md");
-  val_cmd->add_option("cases", val.only, "Case numbers to run, e.g. 01 (default: all)");
+  val_cmd->add_option("cases", val.only, "Case numbers to run, e.g. 01, or mandel (default: all)");
   auto* full_flag = val_cmd->add_flag("--full", val.full, "docs/cases.md acceptance resolutions");
   val_cmd->add_flag("--quick", val_quick, "Coarse resolutions that fit in CI (default)")->excludes(full_flag);
   val_cmd->add_option("--out,-o", val.out_dir, "Report folder (default: validation)");

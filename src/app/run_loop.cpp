@@ -192,15 +192,15 @@ int run_loop(const LoopInput& in) {
   // Output streams: a fresh run starts them; a resumed one cuts them back to the checkpoint.
   io::RowFile probe_csv((out / "probes.csv").string(), resuming ? in.checkpoint->integer("run/probes_bytes") : -1);
   io::RowFile energy_csv((out / "energy.csv").string(), resuming ? in.checkpoint->integer("run/energy_bytes") : -1);
-  // bodies.csv (V2 with rigid bodies): one row per body at every output step.
-  const ContactEnforce* bodies = nullptr;
+  // bodies.csv (rigid bodies, V1/V2/V3): one row per body at every output step.
+  const BodyOutput* bodies = nullptr;
   for (const auto& stage : solver.scheme().stages()) {
-    if (auto* c = dynamic_cast<const ContactEnforce*>(stage.get())) bodies = c;
+    if (auto* c = dynamic_cast<const BodyOutput*>(stage.get())) bodies = c;
   }
   std::optional<io::RowFile> bodies_csv;
   if (bodies != nullptr) {
     bodies_csv.emplace((out / "bodies.csv").string(), resuming ? in.checkpoint->integer("run/bodies_bytes") : -1);
-    if (!resuming) bodies_csv->append(ContactEnforce::csv_header());
+    if (!resuming) bodies_csv->append(body_csv_header());
   }
   // runout.csv and deposit.csv (V2 in 2D with rigid bodies, docs/output.md "Run-out measures"):
   // the deposit's front, heights, particle disorder and mass at every output step, and the
@@ -208,7 +208,7 @@ int run_loop(const LoopInput& in) {
   // leftmost reference positions (x - u), so a resumed run finds them as a fresh one did.
   std::optional<io::RowFile> runout_csv;
   double runout_x0 = 0.0, runout_base = 0.0;
-  if (bodies != nullptr) {
+  if (bodies != nullptr && setup.version == "v2") {
     // A checkpoint of a build without the file restarts it (-1: an empty file and its header).
     const bool kept = resuming && in.checkpoint->has("run/runout_bytes");
     runout_csv.emplace((out / "runout.csv").string(), kept ? in.checkpoint->integer("run/runout_bytes") : -1);

@@ -114,7 +114,7 @@ void NodalConstraints<Dim>::resolve(const std::vector<BoundarySpec<Dim>>& specs,
         }
       }
       for (const auto& [axis, value] : spec.velocity) {
-        set(i, {axis, value, spec.function}, 1.0);
+        set(i, {axis, value, spec.function, spec.body}, 1.0);
         for (int d = 0; d < Dim; ++d) {
           if ((planes >> d) & 1u)
             velocity_on_face[i] = static_cast<std::uint16_t>(velocity_on_face[i] | (1u << (axis * Dim + d)));

@@ -17,11 +17,13 @@
 namespace rktsph {
 
 /// One prescribed component at a node: the velocity along an axis (component < Dim) or a
-/// stress slot (component = Dim + slot), scaled by a time function.
+/// stress slot (component = Dim + slot), scaled by a time function, or the velocity of a rigid
+/// body (body >= 0, small deformation: bodies/plates.hpp).
 struct NodalConstraint {
   int component = 0;
   double value = 0.0;
   int function = -1;
+  int body = -1;
 };
 
 template <int Dim>

@@ -312,18 +312,15 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     s->finish();
   }
 
-  // ---- rigid bodies (V2 in 2D, with the detected free surface: a lattice face keeps its
+  // ---- rigid bodies (2D; in V2 with the detected free surface: a lattice face keeps its
   // traction-free condition in global axes, which a contact would have to override)
   {
     const std::vector<io::Section> bodies = root.tables("body");
     if (!bodies.empty()) {
       if constexpr (Dim == 2) {
-        if (c.version != "v2") {
-          root.fail("body", fmt::format("rigid bodies need solver.version = \"v2\" (this case has \"{}\"); the "
-                                        "small-deformation schemes take [[boundary]] entries",
-                                        c.version));
-        }
-        if (!c.detect_free_surface) {
+        // V1 and V3 (small deformation) take bodies that lie on a face of the lattice
+        // (bodies/plates.hpp); the model checks their shape against the nodes.
+        if (c.version == "v2" && !c.detect_free_surface) {
           root.fail("body",
                     "rigid bodies need solver.free_surface = \"detect\": on the lattice's faces the "
                     "traction-free condition would cancel the contact pressure");

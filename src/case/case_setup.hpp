@@ -81,6 +81,9 @@ struct BoundarySpec {
   /// positive, t = e_z x n (method-notes §3.9), imposed by the rotation of §3.7.
   std::optional<std::array<double, 2>> traction;
   int function = -1;                             // index into CaseSetup::functions, -1 = 1
+  /// V1/V3: the velocity components are those of rigid body `body` (bodies/plates.hpp), not
+  /// value * function; -1 = none. Made by the model from a [[body]], not read from [[boundary]].
+  int body = -1;
   // V3 (saturated) pore-pressure conditions, method-notes §4.1: a drained face (p_w prescribed,
   // Pa, scaled by `function`) or an explicitly impermeable one (dp_w/dn = 0, the default).
   std::optional<double> pore_pressure;

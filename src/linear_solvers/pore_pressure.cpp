@@ -4,6 +4,7 @@
 #pragma GCC diagnostic ignored "-Wnull-dereference"
 #include "linear_solvers/pore_pressure.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -414,6 +415,37 @@ void PorePressureSolver::solve(std::span<const double> source, std::span<const d
   stats_.last_error = error;
   stats_.max_error = std::max(stats_.max_error, error);
   stats_.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+void PorePressureSolver::solve_matrix(std::span<const double> b, std::span<double> x) {
+  const auto nf = static_cast<Eigen::Index>(free_.size());
+  std::fill(x.begin(), x.end(), 0.0);
+  if (nf == 0) return;
+  Impl& m = *impl_;
+  Eigen::VectorXd rhs(nf), guess = Eigen::VectorXd::Zero(nf), out;
+  for (Eigen::Index r = 0; r < nf; ++r) rhs[r] = b[static_cast<std::size_t>(free_[static_cast<std::size_t>(r)])];
+  int iterations = 0;
+  double error = 0.0;
+  bool ok = false;
+  auto run = [&](auto& cg) {
+    out = cg.solveWithGuess(rhs, guess);
+    iterations = static_cast<int>(cg.iterations());
+    error = cg.error();
+    ok = cg.info() == Eigen::Success;
+  };
+  if (m.coupled) {
+    run(m.bicgstab);
+  } else if (settings_.preconditioner == PressurePreconditioner::incomplete_cholesky) {
+    run(m.cg_ic);
+  } else {
+    run(m.cg_diag);
+  }
+  if (!ok || !std::isfinite(error)) {
+    throw SolverError(fmt::format("pore pressure: the rigid-body coupling solve did not converge ({} iterations, "
+                                  "relative residual {:.3g})",
+                                  iterations, error));
+  }
+  for (Eigen::Index r = 0; r < nf; ++r) x[static_cast<std::size_t>(free_[static_cast<std::size_t>(r)])] = out[r];
 }
 
 }  // namespace rktsph

@@ -79,6 +79,12 @@ class PorePressureSolver {
   /// SolverError if the conjugate gradient does not converge.
   void solve(std::span<const double> source, std::span<const double> p_old, std::span<double> p);
 
+  /// x = K^{-1} b on the free nodes, zero at the drained ones (b and x per node): the system
+  /// matrix alone, no right-hand-side operator, from a zero guess; neither the warm start nor
+  /// the statistics change. For the rigid bodies' coupling (method-notes eq. (4.6.3)), set up
+  /// once. Throws SolverError if the iteration does not converge.
+  void solve_matrix(std::span<const double> b, std::span<double> x);
+
   const PressureSolveStats& stats() const { return stats_; }
   void set_stats(const PressureSolveStats& s) { stats_ = s; }
   /// The previous solve's p^n on the free unknowns, from which the next starting guess is

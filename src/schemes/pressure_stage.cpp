@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 
+#include <Eigen/Dense>
 #include <fmt/format.h>
 
 #include "core/error.hpp"
@@ -117,6 +118,132 @@ PorePressureStage<Dim>::PorePressureStage(StaggeredModel<Dim>& model) : m_(model
   } else {
     solver_ = std::make_unique<PorePressureSolver>(lap.full, lap.symmetric, conditions_.drained, s, nullptr, nullptr,
                                                    coupling);
+  }
+  if (m_.plates != nullptr && m_.plates->any_force()) {
+    if (fl.divergence_from_stress_points) {
+      throw InputError(fmt::format(
+          "{}: a force-driven rigid body needs solver.pressure_divergence = \"nodes\" (the default): its "
+          "velocity is eliminated from the storage equation through the nodal divergence (method-notes §4.6)",
+          m_.setup.file));
+    }
+    couple_bodies();
+  }
+}
+
+template <int Dim>
+void PorePressureStage<Dim>::couple_bodies() {
+  // method-notes eq. (4.6.3): the force-driven velocity of body j is V_j = V*_j + (dt/M_j) a_j.p
+  // (the pore-pressure part of its reaction, implicit), and the storage equation sees it
+  // through the nodal divergence, S_w d_j V_j. Eliminating V_j gives (K + sum_j u_j a_j^T) p = b
+  // with u_j = S_w (dt/M_j) d_j: a low-rank update of K, solved by the Woodbury identity from
+  // one ordinary solve a step and the z_j = K^{-1} u_j set up here (K does not change).
+  if constexpr (Dim == 2) {
+    const auto nn = static_cast<std::size_t>(m_.nodes.size());
+    const double dt = m_.time_step.dt;
+    const double sw = m_.setup.fluid.saturation;
+    const CorrectedOperator<Dim>& op = node_operator_;
+    std::vector<int> on_body(nn, -1);
+    for (std::size_t b = 0; b < m_.plates->size(); ++b) {
+      const RigidPlates::Plate& plate = m_.plates->plates()[b];
+      for (const Index i : plate.nodes) on_body[static_cast<std::size_t>(i)] = static_cast<int>(b);
+      for (int d = 0; d < 2; ++d) {
+        if (!plate.spec.force_driven[static_cast<std::size_t>(d)]) continue;
+        // Only a held component moves with the body (the normal one of a smooth body).
+        if (d != plate.normal_axis && !plate.full) continue;
+        BodyCoupling c;
+        c.body = b;
+        c.axis = d;
+        c.gain = dt / plate.spec.mass;
+        c.nodes = plate.nodes;
+        for (std::size_t k = 0; k < plate.nodes.size(); ++k) c.weight.push_back(-plate.normal[d] * plate.length[k]);
+        c.divergence.assign(nn, 0.0);
+        bodies_.push_back(std::move(c));
+      }
+    }
+    if (bodies_.empty()) return;
+    for (BodyCoupling& c : bodies_) {
+      for (std::size_t i = 0; i < nn; ++i) {
+        double div = 0.0;
+        const Index row = op.pattern[i];
+        for (Index k = op.pattern_start[static_cast<std::size_t>(row)]; k < op.pattern_start[static_cast<std::size_t>(row) + 1]; ++k) {
+          const auto j = static_cast<std::size_t>(op.base[i] + op.offset[static_cast<std::size_t>(k)]);
+          if (on_body[j] == static_cast<int>(c.body)) div += op.grad[static_cast<std::size_t>(k)][static_cast<std::size_t>(c.axis)];
+        }
+        c.divergence[i] = div;
+      }
+      std::vector<double> u(nn);
+      for (std::size_t i = 0; i < nn; ++i) u[i] = sw * c.gain * c.divergence[i];
+      c.z.assign(nn, 0.0);
+      solver_->solve_matrix(u, c.z);
+    }
+    const auto m = static_cast<Eigen::Index>(bodies_.size());
+    Eigen::MatrixXd g = Eigen::MatrixXd::Identity(m, m);
+    for (Eigen::Index r = 0; r < m; ++r) {
+      const BodyCoupling& a = bodies_[static_cast<std::size_t>(r)];
+      for (Eigen::Index q = 0; q < m; ++q) {
+        const BodyCoupling& z = bodies_[static_cast<std::size_t>(q)];
+        for (std::size_t k = 0; k < a.nodes.size(); ++k) g(r, q) += a.weight[k] * z.z[static_cast<std::size_t>(a.nodes[k])];
+      }
+    }
+    const Eigen::MatrixXd inv = g.inverse();
+    body_inverse_.resize(static_cast<std::size_t>(m * m));
+    for (Eigen::Index r = 0; r < m; ++r)
+      for (Eigen::Index q = 0; q < m; ++q) body_inverse_[static_cast<std::size_t>(r * m + q)] = inv(r, q);
+    body_dv_.assign(bodies_.size(), 0.0);
+    body_w_.assign(bodies_.size(), 0.0);
+  }
+}
+
+template <int Dim>
+void PorePressureStage<Dim>::solve_with_bodies() {
+  double* pw = m_.nodes.view(pressure_).data();
+  const auto nn = static_cast<std::size_t>(m_.nodes.size());
+  if (bodies_.empty()) {
+    solver_->solve(source_, p_old_, {pw, nn});
+    return;
+  }
+  const double sw = m_.setup.fluid.saturation;
+  const std::size_t m = bodies_.size();
+  // The drained nodes on a body: their p^{n+1} is known, so their part of dV_j is too.
+  std::vector<double>& dv = body_dv_;
+  for (std::size_t j = 0; j < m; ++j) {
+    const BodyCoupling& c = bodies_[j];
+    double known = 0.0;
+    for (std::size_t k = 0; k < c.nodes.size(); ++k) {
+      const auto i = static_cast<std::size_t>(c.nodes[k]);
+      if (conditions_.drained[i]) known += c.weight[k] * pw[i];
+    }
+    dv[j] = c.gain * known;
+    if (dv[j] != 0.0) {
+      for (std::size_t i = 0; i < nn; ++i) source_[i] -= sw * c.divergence[i] * dv[j];
+    }
+  }
+  solver_->solve(source_, p_old_, {pw, nn});
+  // Woodbury: p = y - Z (I + W^T Z)^{-1} W^T y on the free nodes (z_j is zero at drained ones).
+  std::vector<double>& w = body_w_;
+  for (std::size_t j = 0; j < m; ++j) {
+    const BodyCoupling& c = bodies_[j];
+    double sum = 0.0;
+    for (std::size_t k = 0; k < c.nodes.size(); ++k) {
+      const auto i = static_cast<std::size_t>(c.nodes[k]);
+      if (!conditions_.drained[i]) sum += c.weight[k] * pw[i];
+    }
+    w[j] = sum;
+  }
+  for (std::size_t q = 0; q < m; ++q) {
+    double cq = 0.0;
+    for (std::size_t r = 0; r < m; ++r) cq += body_inverse_[q * m + r] * w[r];
+    const std::vector<double>& z = bodies_[q].z;
+    for (std::size_t i = 0; i < nn; ++i) pw[i] -= z[i] * cq;
+  }
+  for (std::size_t j = 0; j < m; ++j) {
+    const BodyCoupling& c = bodies_[j];
+    double sum = 0.0;
+    for (std::size_t k = 0; k < c.nodes.size(); ++k) {
+      const auto i = static_cast<std::size_t>(c.nodes[k]);
+      if (!conditions_.drained[i]) sum += c.weight[k] * pw[i];
+    }
+    m_.plates->add_pressure_velocity(c.body, c.axis, dv[j] + c.gain * sum);
   }
 }
 
@@ -254,7 +381,7 @@ void PorePressureStage<Dim>::run(const StepContext& context) {
       source_[static_cast<std::size_t>(i)] += sw * stabilisation_time_ * div;
     });
   }
-  solver_->solve(source_, pw_old, {pw, static_cast<std::size_t>(nn)});
+  solve_with_bodies();
   // Velocity correction v^{n+1} = v* - (dt/rho) grad p^{n+1} (same-set corrected gradient).
   exec::particle_for(m_.policy, nn, [&](Index i) {
     double g[Dim];

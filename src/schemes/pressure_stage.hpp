@@ -71,6 +71,23 @@ class PorePressureStage final : public Stage {
   std::vector<double> p_old_, source_;
   std::vector<double> pressure_gradient_;  // incremental projection: grad p^n / rho (Dim per node)
   std::vector<double> skeleton_;           // pressure-free half-step velocity (Dim per stress point)
+  /// Force-driven rigid bodies (small deformation, method-notes eq. (4.6.3)): per coupled
+  /// (body, axis) j, its nodes and their weights a_j = -n A_I (the reaction on the body per unit
+  /// p_w), dt/M, the divergence per unit body velocity d_j (per node) and z_j = K^{-1} S_w
+  /// (dt/M) d_j; and (I + W^T Z)^{-1} (row-major, j x j).
+  struct BodyCoupling {
+    std::size_t body = 0;
+    int axis = 0;
+    double gain = 0.0;  // dt / M, s/kg (per unit thickness)
+    std::vector<Index> nodes;
+    std::vector<double> weight;
+    std::vector<double> divergence, z;
+  };
+  std::vector<BodyCoupling> bodies_;
+  std::vector<double> body_inverse_;
+  std::vector<double> body_dv_, body_w_;  // per coupling, scratch of the step
+  void couple_bodies();
+  void solve_with_bodies();
   double inv_storage_ = 0.0;
   double stabilisation_time_ = 0.0;  // dt (method-notes §2.4) or dt/2 (stress-point divergence)
   double undrained_courant_ = 0.0;

@@ -144,7 +144,39 @@ StaggeredModel<Dim>::StaggeredModel(CaseSetup<Dim> case_setup, exec::Threads thr
   node_sources = make_source_runs(nodes, materials);
   stress_point_sources = make_source_runs(stress_points, materials);
 
-  constraints.resolve(setup.boundaries, nodes, boundary, setup.dx, !setup.detect_free_surface);
+  // Rigid bodies in small deformation (method-notes §4.6): the nodes on each body found once,
+  // and held by constraints whose value is the body's velocity (smooth: the normal component,
+  // rough and bonded: both), appended after the case's entries so that the body wins.
+  std::vector<BoundarySpec<Dim>> entries = setup.boundaries;
+  if constexpr (Dim == 2) {
+    if (!setup.bodies.empty() && setup.version != "v2") {
+      const std::vector<std::uint8_t> faces = boundary.dense_faces(nodes.size());
+      plates = std::make_shared<RigidPlates>(
+          setup.bodies, nodes.position, faces, setup.dx,
+          [functions = setup.functions](int f, double t) {
+            return f < 0 ? 1.0 : functions[static_cast<std::size_t>(f)](t);
+          },
+          setup.file);
+      for (std::size_t b = 0; b < plates->size(); ++b) {
+        const RigidPlates::Plate& p = plates->plates()[b];
+        BoundarySpec<Dim> e;
+        e.name = p.spec.name;
+        e.where = p.spec.where;
+        Vec<Dim> lo = nodes.position[static_cast<std::size_t>(p.nodes.front())];
+        Vec<Dim> hi = lo;
+        for (const Index i : p.nodes) {
+          lo = lo.cwiseMin(nodes.position[static_cast<std::size_t>(i)]);
+          hi = hi.cwiseMax(nodes.position[static_cast<std::size_t>(i)]);
+        }
+        e.region = Region<Dim>::box(lo, hi);
+        e.velocity.emplace_back(p.normal_axis, 0.0);
+        if (p.full) e.velocity.emplace_back(1 - p.normal_axis, 0.0);
+        e.body = static_cast<int>(b);
+        entries.push_back(std::move(e));
+      }
+    }
+  }
+  constraints.resolve(entries, nodes, boundary, setup.dx, !setup.detect_free_surface);
   std::vector<Vec<Dim>> constrained_positions;
   for (const Index i : constraints.constrained())
     constrained_positions.push_back(nodes.position[static_cast<std::size_t>(i)]);
@@ -294,6 +326,12 @@ void StaggeredModel<Dim>::set_initial_state() {
     if (k.components() > 0) materials[m].initial_state(to_sym6<Dim>(s[i]), k[i]);
   }
   apply_constraints(0.0);
+  if constexpr (Dim == 2) {
+    if (plates) {
+      const auto st = nodes.view(fields.stress);
+      plates->measure({st.data(), st.size(), RigidPlates::NS}, pore_pressure_);
+    }
+  }
 
   // The stress points' state at t = 0: the nodal state interpolated to them, as step 1 starts
   // from it (method-notes §3.3: nodes are primary). Only the t = 0 output reads it: step 1

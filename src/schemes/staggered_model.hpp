@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "bc/constraints.hpp"
+#include "bodies/plates.hpp"
 #include "case/case_setup.hpp"
 #include "core/execution.hpp"
 #include "core/kernel.hpp"
@@ -105,6 +106,9 @@ class StaggeredModel {
     DifferenceGradient<Dim> gradient;
   } contact;
   SourceRuns node_sources, stress_point_sources;
+  /// Rigid bodies in small deformation (V1, V3 in 2D; bodies/plates.hpp, method-notes §4.6):
+  /// null without [[body]] and in V2, whose bodies move (bodies/contact.hpp).
+  std::shared_ptr<RigidPlates> plates;
 
   double dx() const { return setup.dx; }
   double function_value(int f, double t) const { return setup.function_value(f, t); }
@@ -114,6 +118,7 @@ class StaggeredModel {
   /// Value of a prescribed component at node i at time t. A prescribed normal stress is a
   /// TOTAL stress: with a pore pressure the effective stress held is sigma + p_w.
   double constraint_value(Index i, const NodalConstraint& c, double t) const {
+    if (c.body >= 0) return plates->velocity_at(static_cast<std::size_t>(c.body), c.component, t);
     double v = c.value * function_value(c.function, t);
     if (pore_pressure_ != nullptr && c.component >= Dim && c.component < 2 * Dim) v += pore_pressure_[i];
     return v;

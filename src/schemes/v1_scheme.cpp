@@ -3,8 +3,11 @@
 //   2. nodes: full step from the stress points (flux + sources), and the displacement
 //   3. prescribed components at t^{n+1}
 //   4. the velocity filter (solver.filter), and the prescribed components again.
+// With rigid bodies (2D, method-notes §4.6): their velocities at t^{n+1} before 3, their
+// offsets and reactions after 4.
 #include <memory>
 
+#include "schemes/plate_stages.hpp"
 #include "schemes/registry.hpp"
 #include "schemes/staggered_stages.hpp"
 
@@ -16,10 +19,16 @@ std::unique_ptr<Scheme> make_v1_scheme(StaggeredModel<Dim>& model) {
   auto sources = std::make_shared<ViscoplasticSources<Dim>>(model);
   scheme->add(std::make_unique<StressPointHalfStep<Dim>>(model, sources));
   scheme->add(std::make_unique<NodeFullStep<Dim>>(model, sources));
+  if constexpr (Dim == 2) {
+    if (model.plates) scheme->add(std::make_unique<DriveRigidPlates>(model));
+  }
   scheme->add(std::make_unique<ApplyConstraints<Dim>>(model));
   if (model.setup.filter) {
     scheme->add(std::make_unique<VelocityFilter<Dim>>(model, model.setup.filter_strength));
     scheme->add(std::make_unique<ApplyConstraints<Dim>>(model));
+  }
+  if constexpr (Dim == 2) {
+    if (model.plates) scheme->add(std::make_unique<FinishRigidPlates>(model));
   }
   return scheme;
 }

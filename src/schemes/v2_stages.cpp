@@ -255,37 +255,15 @@ std::size_t ContactEnforce::scratch_bytes() const {
 
 std::vector<std::pair<std::string, double>> ContactEnforce::report() const {
   std::vector<std::pair<std::string, double>> out;
-  for (std::size_t b = 0; b < contact_->bodies().size(); ++b) {
-    const std::string& name = contact_->bodies()[b].spec().name;
-    const BodyState& st = contact_->state()[b];
-    out.emplace_back(name + ".Fx", st.force[0]);
-    out.emplace_back(name + ".Fy", st.force[1]);
-    out.emplace_back(name + ".contact_width", st.width);
-    out.emplace_back(name + ".contact_nodes", static_cast<double>(st.contact_nodes));
-    out.emplace_back(name + ".node_projections", static_cast<double>(st.node_projections));
-    out.emplace_back(name + ".stress_point_projections", static_cast<double>(st.stress_point_projections));
-    out.emplace_back(name + ".displacement_x", st.offset[0]);
-    out.emplace_back(name + ".displacement_y", st.offset[1]);
-    out.emplace_back(name + ".work", st.work);
-  }
+  for (std::size_t b = 0; b < contact_->bodies().size(); ++b)
+    add_body_report(contact_->bodies()[b].spec().name, contact_->state()[b], out);
   return out;
-}
-
-std::string ContactEnforce::csv_header() {
-  return "t,body,ux,uy,vx,vy,Fx,Fy,contact_width,contact_nodes,node_projections,stress_point_projections,work,"
-         "min_gap\n";
 }
 
 std::string ContactEnforce::csv_rows(double t) const {
   std::string rows;
-  for (std::size_t b = 0; b < contact_->bodies().size(); ++b) {
-    const BodyState& st = contact_->state()[b];
-    const double gap = std::isfinite(st.min_gap) ? st.min_gap : 0.0;
-    rows += fmt::format("{:.10g},{},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{},{},{},{:.10g},{:.10g}\n",
-                        t, contact_->bodies()[b].spec().name, st.offset[0], st.offset[1], st.velocity[0],
-                        st.velocity[1], st.force[0], st.force[1], st.width, st.contact_nodes, st.node_projections,
-                        st.stress_point_projections, st.work, gap);
-  }
+  for (std::size_t b = 0; b < contact_->bodies().size(); ++b)
+    rows += body_csv_row(t, contact_->bodies()[b].spec().name, contact_->state()[b]);
   return rows;
 }
 

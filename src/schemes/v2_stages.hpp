@@ -10,6 +10,7 @@
 #include "bodies/contact.hpp"
 #include "neighbours/relation.hpp"
 #include "operators/free_surface.hpp"
+#include "schemes/body_output.hpp"
 #include "schemes/stage.hpp"
 #include "schemes/staggered_model.hpp"
 
@@ -151,7 +152,7 @@ class ContactSelect final : public Stage {
 /// Rigid bodies after step 2 and the prescribed components: the contact constraints at
 /// t^{n+1}, the projections and the reactions. Keeps the bodies' state in checkpoints and
 /// writes their rows of bodies.csv.
-class ContactEnforce final : public Stage {
+class ContactEnforce final : public Stage, public BodyOutput {
  public:
   ContactEnforce(StaggeredModel<2>& model, std::shared_ptr<RigidContact> contact)
       : m_(model), contact_(std::move(contact)) {}
@@ -162,9 +163,7 @@ class ContactEnforce final : public Stage {
   void load(const io::StateArchive& archive, const std::string& prefix) override { contact_->load(archive, prefix); }
   std::vector<std::pair<std::string, double>> report() const override;
   const RigidContact& contact() const { return *contact_; }
-  /// bodies.csv (docs/output.md): the header, and one row per body at time t.
-  static std::string csv_header();
-  std::string csv_rows(double t) const;
+  std::string csv_rows(double t) const override;
 
  private:
   StaggeredModel<2>& m_;

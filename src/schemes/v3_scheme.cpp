@@ -5,9 +5,12 @@
 //   3. prescribed components (total stresses: sigma' = sigma + p_w)
 //   4. pressure: the storage equation by PCG, v^{n+1} = v* - (dt/rho) grad p^{n+1}
 //   5. prescribed components; the velocity filter and the prescribed components again.
+// With rigid bodies (2D, method-notes §4.6): their velocities at t^{n+1} before 3 without the
+// pore pressure, whose part the pressure stage adds (implicit); offsets and reactions last.
 #include <memory>
 
 #include "schemes/pressure_stage.hpp"
+#include "schemes/plate_stages.hpp"
 #include "schemes/registry.hpp"
 #include "schemes/staggered_stages.hpp"
 
@@ -23,12 +26,18 @@ std::unique_ptr<Scheme> make_v3_scheme(StaggeredModel<Dim>& model) {
   auto sources = std::make_shared<ViscoplasticSources<Dim>>(model);
   scheme->add(std::make_unique<StressPointHalfStep<Dim, PorePressureGradient<Dim>>>(model, sources, gradient));
   scheme->add(std::make_unique<NodeFullStep<Dim>>(model, sources));
+  if constexpr (Dim == 2) {
+    if (model.plates) scheme->add(std::make_unique<DriveRigidPlates>(model));
+  }
   scheme->add(std::make_unique<ApplyConstraints<Dim>>(model));
   PorePressureStage<Dim>& stage = scheme->add(std::move(pressure));
   scheme->add(std::make_unique<ApplyConstraints<Dim>>(model));
   if (model.setup.filter) {
     scheme->add(std::make_unique<VelocityFilter<Dim>>(model, model.setup.filter_strength));
     scheme->add(std::make_unique<ApplyConstraints<Dim>>(model));
+  }
+  if constexpr (Dim == 2) {
+    if (model.plates) scheme->add(std::make_unique<FinishRigidPlates>(model));
   }
   // The fluid's stored energy p^2/(2 Q*) per unit volume joins the energy account, and the
   // growth guard names the undrained Courant limit when it applies.

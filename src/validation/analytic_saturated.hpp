@@ -1,6 +1,8 @@
 #pragma once
 // Closed-form references of the saturated (V3) validation cases (docs/cases.md Cases 13 and 14),
-// for the u-p_w model (C4) in one dimension. z is the depth from the drained, loaded top.
+// for the u-p_w model (C4) in one dimension (z is the depth from the drained, loaded top), and
+// Mandel's problem in plane strain (cases/examples/mandel_2d.toml).
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <complex>
@@ -134,6 +136,83 @@ struct HarmonicColumn {
       u += r(s[j]) * coef[j] * std::exp(s[j] * (z - col.height)) + r(-s[j]) * coef[2 + j] * std::exp(-s[j] * z);
     }
     return u;
+  }
+};
+
+/// Mandel's problem (Mandel 1953; the series of Abousleiman et al. 1996, Cheng 2016 §7.8): a
+/// plane-strain sample -a <= x <= a between rigid, smooth, impermeable plates pressed together by
+/// the force 2F (F per half plate, N/m, compression positive), drained and traction-free at
+/// x = +-a; incompressible constituents' grains (Biot alpha = 1), fluid storage 1/M. The load is
+/// ramped from 0 over `ramp` seconds (exact convolution of the step solution; 0: a step).
+struct Mandel {
+  double E = 0.0, nu = 0.0;   // drained skeleton
+  double storage = 0.0;       // M = Q* (1/M = n/K_f), Pa
+  double permeability = 0.0;  // k_w = k / gamma_w, m^3 s/kg
+  double half_width = 1.0;    // a, m
+  double force = 0.0;         // F, N/m
+  double ramp = 0.0;          // s
+  static constexpr int kTerms = 200;
+
+  double shear() const { return E / (2.0 * (1.0 + nu)); }
+  double bulk() const { return E / (3.0 * (1.0 - 2.0 * nu)); }
+  double skempton() const { return storage / (bulk() + storage); }
+  double undrained_nu() const {
+    const double ku = bulk() + storage, g = shear();
+    return (3.0 * ku - 2.0 * g) / (2.0 * (3.0 * ku + g));
+  }
+  /// Consolidation coefficient c = k_w M (K + 4G/3) / (K_u + 4G/3), m^2/s.
+  double consolidation() const {
+    const double m43 = 4.0 * shear() / 3.0;
+    return permeability * storage * (bulk() + m43) / (bulk() + storage + m43);
+  }
+  /// The undrained centre pressure F B (1 + nu_u) / (3 a) at t = 0+, Pa.
+  double initial_pressure() const { return force * skempton() * (1.0 + undrained_nu()) / (3.0 * half_width); }
+  /// The roots alpha_n of tan(alpha) = (1 - nu)/(nu_u - nu) alpha in (n pi, n pi + pi/2).
+  std::array<double, kTerms> roots() const {
+    std::array<double, kTerms> r{};
+    const double k = (1.0 - nu) / (undrained_nu() - nu);
+    for (int n = 0; n < kTerms; ++n) {
+      double lo = n * std::numbers::pi + 1e-12, hi = n * std::numbers::pi + std::numbers::pi / 2.0 - 1e-12;
+      if (n == 0) lo = 1e-9;  // tan(x) - k x < 0 just above 0 (k > 1)
+      for (int it = 0; it < 200; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        if ((std::tan(mid) - k * mid) < 0.0) {
+          lo = mid;
+        } else {
+          hi = mid;
+        }
+      }
+      r[static_cast<std::size_t>(n)] = 0.5 * (lo + hi);
+    }
+    return r;
+  }
+  // The ramp's average of exp(-l (t - s)) over the loading history, times the load fraction.
+  double ramp_factor(double l, double t) const {
+    if (ramp <= 0.0) return std::exp(-l * t);
+    if (t <= 0.0) return 0.0;
+    if (t < ramp) return -std::expm1(-l * t) / (l * ramp);
+    return std::exp(-l * (t - ramp)) * (-std::expm1(-l * ramp)) / (l * ramp);
+  }
+  double load_fraction(double t) const { return ramp > 0.0 ? std::clamp(t / ramp, 0.0, 1.0) : (t > 0.0 ? 1.0 : 0.0); }
+  /// p_w(x, t), Pa.
+  double pressure(double x, double t) const {
+    const double a = half_width, rate = consolidation() / (a * a);
+    double s = 0.0;
+    for (const double al : roots()) {
+      const double sc = std::sin(al) * std::cos(al);
+      s += std::sin(al) / (al - sc) * (std::cos(al * x / a) - std::cos(al)) * ramp_factor(al * al * rate, t);
+    }
+    return 2.0 * initial_pressure() * s;
+  }
+  /// The plates' approach per unit half height, -u_y(b, t)/b (positive in compression).
+  double strain(double t) const {
+    const double a = half_width, g = shear(), nuu = undrained_nu(), rate = consolidation() / (a * a);
+    double s = 0.0;
+    for (const double al : roots()) {
+      const double sc = std::sin(al) * std::cos(al);
+      s += sc / (al - sc) * ramp_factor(al * al * rate, t);
+    }
+    return force * (1.0 - nu) / (2.0 * g * a) * load_fraction(t) - force * (1.0 - nuu) / (g * a) * s;
   }
 };
 

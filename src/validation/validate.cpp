@@ -37,6 +37,8 @@ int run_validation(const Options& opt) {
       {"11", validate_case11}, {"12", validate_case12},
       {"13", validate_case13}, {"14", validate_case14}, {"15", validate_case15}, {"16", validate_case16},
       {"17", validate_case17},
+      // Beyond the thesis (cases/examples/).
+      {"mandel", validate_mandel},
   };
   fs::create_directories(opt.out_dir);
   std::vector<CaseReport> reports;

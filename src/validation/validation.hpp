@@ -87,6 +87,8 @@ CaseReport validate_case14(const Options& options, const std::string& case_dir);
 CaseReport validate_case15(const Options& options, const std::string& case_dir);
 CaseReport validate_case16(const Options& options, const std::string& case_dir);
 CaseReport validate_case17(const Options& options, const std::string& case_dir);
+/// Mandel's problem with a force-driven rigid plate (cases/examples/mandel_2d.toml).
+CaseReport validate_mandel(const Options& options, const std::string& case_dir);
 
 /// Run the selected cases and write out_dir/report.md. Returns 0 if all pass, 1 otherwise.
 int run_validation(const Options& options);
