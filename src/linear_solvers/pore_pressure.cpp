@@ -387,20 +387,7 @@ void PorePressureSolver::solve(std::span<const double> source, std::span<const d
   m.R.multiply_add(std::span<const double>(m.p_all.data(), static_cast<std::size_t>(m.p_all.size())), rhs, 1.0);
   int iterations = 0;
   double error = 0.0;
-  bool ok = false;
-  auto run = [&](auto& cg) {
-    m.x = cg.solveWithGuess(m.rhs, m.x);
-    iterations = static_cast<int>(cg.iterations());
-    error = cg.error();
-    ok = cg.info() == Eigen::Success;
-  };
-  if (m.coupled) {
-    run(m.bicgstab);
-  } else if (settings_.preconditioner == PressurePreconditioner::incomplete_cholesky) {
-    run(m.cg_ic);
-  } else {
-    run(m.cg_diag);
-  }
+  const bool ok = iterate(m.rhs, m.x, iterations, error);
   if (!ok || !std::isfinite(error)) {
     throw SolverError(
         fmt::format("pore pressure: the {} did not converge ({} iterations, "
@@ -417,18 +404,11 @@ void PorePressureSolver::solve(std::span<const double> source, std::span<const d
   stats_.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-void PorePressureSolver::solve_matrix(std::span<const double> b, std::span<double> x) {
-  const auto nf = static_cast<Eigen::Index>(free_.size());
-  std::fill(x.begin(), x.end(), 0.0);
-  if (nf == 0) return;
+bool PorePressureSolver::iterate(const Eigen::VectorXd& b, Eigen::VectorXd& x, int& iterations, double& error) {
   Impl& m = *impl_;
-  Eigen::VectorXd rhs(nf), guess = Eigen::VectorXd::Zero(nf), out;
-  for (Eigen::Index r = 0; r < nf; ++r) rhs[r] = b[static_cast<std::size_t>(free_[static_cast<std::size_t>(r)])];
-  int iterations = 0;
-  double error = 0.0;
   bool ok = false;
   auto run = [&](auto& cg) {
-    out = cg.solveWithGuess(rhs, guess);
+    x = cg.solveWithGuess(b, x);
     iterations = static_cast<int>(cg.iterations());
     error = cg.error();
     ok = cg.info() == Eigen::Success;
@@ -440,6 +420,18 @@ void PorePressureSolver::solve_matrix(std::span<const double> b, std::span<doubl
   } else {
     run(m.cg_diag);
   }
+  return ok;
+}
+
+void PorePressureSolver::solve_matrix(std::span<const double> b, std::span<double> x) {
+  const auto nf = static_cast<Eigen::Index>(free_.size());
+  std::fill(x.begin(), x.end(), 0.0);
+  if (nf == 0) return;
+  Eigen::VectorXd rhs(nf), out = Eigen::VectorXd::Zero(nf);
+  for (Eigen::Index r = 0; r < nf; ++r) rhs[r] = b[static_cast<std::size_t>(free_[static_cast<std::size_t>(r)])];
+  int iterations = 0;
+  double error = 0.0;
+  const bool ok = iterate(rhs, out, iterations, error);
   if (!ok || !std::isfinite(error)) {
     throw SolverError(fmt::format("pore pressure: the rigid-body coupling solve did not converge ({} iterations, "
                                   "relative residual {:.3g})",

@@ -110,6 +110,8 @@ class PorePressureSolver {
  private:
   void build(const PatternMatrix& full, const PatternMatrix& symmetric, const std::vector<bool>& dirichlet,
              const PatternMatrix* filter_symmetric, const PatternMatrix* filter_explicit, const Sparse* face_coupling);
+  /// The configured Krylov solver on K x = b from the guess in x; false if it did not converge.
+  bool iterate(const Eigen::VectorXd& b, Eigen::VectorXd& x, int& iterations, double& error);
   struct Impl;
   std::unique_ptr<Impl> impl_;
   std::vector<Index> free_;   // free node of each unknown

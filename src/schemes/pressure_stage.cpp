@@ -220,16 +220,17 @@ void PorePressureStage<Dim>::solve_with_bodies() {
   }
   solver_->solve(source_, p_old_, {pw, nn});
   // Woodbury: p = y - Z (I + W^T Z)^{-1} W^T y on the free nodes (z_j is zero at drained ones).
-  std::vector<double>& w = body_w_;
-  for (std::size_t j = 0; j < m; ++j) {
-    const BodyCoupling& c = bodies_[j];
+  // a_j . p over the body's free nodes (the drained ones are in dv already).
+  auto free_part = [&](const BodyCoupling& c) {
     double sum = 0.0;
     for (std::size_t k = 0; k < c.nodes.size(); ++k) {
       const auto i = static_cast<std::size_t>(c.nodes[k]);
       if (!conditions_.drained[i]) sum += c.weight[k] * pw[i];
     }
-    w[j] = sum;
-  }
+    return sum;
+  };
+  std::vector<double>& w = body_w_;
+  for (std::size_t j = 0; j < m; ++j) w[j] = free_part(bodies_[j]);
   for (std::size_t q = 0; q < m; ++q) {
     double cq = 0.0;
     for (std::size_t r = 0; r < m; ++r) cq += body_inverse_[q * m + r] * w[r];
@@ -238,12 +239,7 @@ void PorePressureStage<Dim>::solve_with_bodies() {
   }
   for (std::size_t j = 0; j < m; ++j) {
     const BodyCoupling& c = bodies_[j];
-    double sum = 0.0;
-    for (std::size_t k = 0; k < c.nodes.size(); ++k) {
-      const auto i = static_cast<std::size_t>(c.nodes[k]);
-      if (!conditions_.drained[i]) sum += c.weight[k] * pw[i];
-    }
-    m_.plates->add_pressure_velocity(c.body, c.axis, dv[j] + c.gain * sum);
+    m_.plates->add_pressure_velocity(c.body, c.axis, dv[j] + c.gain * free_part(c));
   }
 }
 

@@ -216,4 +216,17 @@ struct Mandel {
   }
 };
 
+/// The constants of cases/examples/mandel_2d.toml (a = 1 m, q = 10 kPa ramped over 0.05 s).
+inline Mandel mandel_example() {
+  Mandel m;
+  m.E = 1.0e7;
+  m.nu = 0.2;
+  m.storage = 2.2e9 / 0.4;
+  m.permeability = 8.846836e-5 / (1000.0 * 9.81);
+  m.half_width = 1.0;
+  m.force = 1.0e4;
+  m.ramp = 0.05;
+  return m;
+}
+
 }  // namespace rktsph::analytic

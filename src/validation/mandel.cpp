@@ -25,19 +25,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// The case file's constants (cases/examples/mandel_2d.toml).
-analytic::Mandel mandel_reference() {
-  analytic::Mandel m;
-  m.E = 1.0e7;
-  m.nu = 0.2;
-  m.storage = 2.2e9 / 0.4;
-  m.permeability = 8.846836e-5 / (1000.0 * 9.81);
-  m.half_width = 1.0;
-  m.force = 1.0e4;
-  m.ramp = 0.05;
-  return m;
-}
-
 struct MandelRun {
   double dx = 0.0;
   std::vector<double> t, p, u;  // centre p_w (Pa), plate settlement (m, positive down)
@@ -144,7 +131,7 @@ CaseReport validate_mandel(const Options& opt, const std::string& dir) {
       "Mandel's exact series (Abousleiman et al. 1996), c = 0.1 m^2/s, p0 = F B (1 + nu_u)/(3a) = 4.994 kPa, "
       "convolved with the 0.05 s load ramp (src/validation/analytic_saturated.hpp)";
   const std::string case_file = (fs::path(opt.cases_dir) / ".." / "examples" / "mandel_2d.toml").string();
-  const analytic::Mandel ref = mandel_reference();
+  const analytic::Mandel ref = analytic::mandel_example();
   const double p0 = ref.initial_pressure();
   // The exact peak of the ramped load, by golden-section search on its unimodal bump.
   double lo = 0.2, hi = 2.0;

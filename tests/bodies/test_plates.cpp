@@ -111,13 +111,7 @@ pore_pressure = 0.0
   text.replace(text.find("spacing = 0.1"), 13, "spacing = 0.05");
   Simulation<2> sim(read_case<2>(parse_case_document(text, "mandel.toml", {})));
   while (sim.time() < 0.4 - 1e-9) sim.step();
-  analytic::Mandel ref;
-  ref.E = 1.0e7;
-  ref.nu = 0.2;
-  ref.storage = 2.2e9 / 0.4;
-  ref.permeability = 8.846836e-5 / (1000.0 * 9.81);
-  ref.force = 1.0e4;
-  ref.ramp = 0.05;
+  const analytic::Mandel ref = analytic::mandel_example();
   std::size_t centre = 0;
   for (std::size_t i = 0; i < sim.nodes().position.size(); ++i) {
     if (sim.nodes().position[i].norm() < sim.nodes().position[centre].norm()) centre = i;
