@@ -33,18 +33,15 @@ def main(folder):
         ax_u.plot(exact["tc_over_a2"], [1e3 * u for u in exact["settlement_exact"]], "k--", lw=1.0,
                   label="exact (Mandel)")
     ax_p.axhline(1.0, color="0.6", lw=0.6)
-    ax_p.set_xscale("log")
-    ax_p.set_xlim(left=1e-3)
-    ax_p.set_xlabel("t c / a$^2$")
     ax_p.set_ylabel("centre $p_w$ / $p_0$")
     ax_p.set_title("Mandel–Cryer effect at the centre")
-    ax_p.legend(fontsize=8)
-    ax_u.set_xscale("log")
-    ax_u.set_xlim(left=1e-3)
-    ax_u.set_xlabel("t c / a$^2$")
     ax_u.set_ylabel("plate settlement (mm)")
     ax_u.set_title("Rigid plate under a constant force")
-    ax_u.legend(fontsize=8)
+    for ax in (ax_p, ax_u):
+        ax.set_xscale("log")
+        ax.set_xlim(left=1e-3)
+        ax.set_xlabel("t c / a$^2$")
+        ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(os.path.join(folder, "mandel.png"), dpi=130)
 

@@ -39,6 +39,14 @@ RigidPlates::RigidPlates(const std::vector<BodySpec>& specs, const std::vector<V
       fail("contact = \"coulomb\" needs solver.version = \"v2\"; in small deformation a body is smooth, rough "
            "or bonded (the contact does not slip or separate)");
     }
+    // The contact is permanent here: nothing separates, so a tension or release rule would be
+    // silently ignored.
+    if (spec.adhesion > 0.0) {
+      fail("adhesion needs solver.version = \"v2\"; in small deformation the contact does not separate");
+    }
+    if (spec.release_on_patch_mean) {
+      fail("release needs solver.version = \"v2\"; in small deformation the contact does not separate");
+    }
     Plate p;
     p.spec = spec;
     // The normal into the soil: a plane's own, or the left of a segment walked from a to b.

@@ -87,6 +87,7 @@ MandelRun run_mandel(const std::string& case_file, double dx, double end, const 
   MandelRun out;
   out.dx = dx;
   const long steps = static_cast<long>(std::ceil(end / solver.dt() - 1e-9));
+  for (auto* history : {&out.t, &out.p, &out.u}) history->reserve(static_cast<std::size_t>(steps) + 1);
   const auto t0 = std::chrono::steady_clock::now();
   for (long n = 0; n <= steps; ++n) {
     if (n > 0) solver.step();

@@ -91,8 +91,9 @@ TEST(SmallDeformationPlates, ForceDrivenPlateSettlesToThePlaneStrainSolution) {
 
 TEST(SmallDeformationPlates, SaturatedPlateGivesMandelsUndrainedResponseAndStaysBounded) {
   // Water's stiffness under an impermeable plate at C = 0.5 (C c_u/c_d = 11): with the pore
-  // pressure explicit in the plate's force balance this needs a plate far heavier than the
-  // block; with it eliminated from the storage equation (eq. (4.6.3)) 100 kg/m is stable.
+  // pressure explicit in the plate's force balance the loop gain Q* dt^2 W/(dx M) asks for a
+  // plate far heavier than the block (an estimate, method-notes §4.6); with it eliminated from
+  // the storage equation (eq. (4.6.3)) 100 kg/m is stable.
   const std::string fluid = R"(
 [fluid]
 porosity = 0.4
@@ -170,6 +171,11 @@ TEST(SmallDeformationPlates, KeysOfTheLargeDeformationSolverAreRefusedClearly) {
   off.replace(off.find("{ a = [1.0, 1.0], b = [0.0, 1.0] }"), 34, "{ a = [1.0, 1.05], b = [0.0, 1.05] }");
   message = input_error(plate_case("v1", off));
   EXPECT_NE(message.find("lies on no node"), std::string::npos) << message;
+
+  std::string adhesion = kPlate;
+  adhesion.replace(adhesion.find("\"smooth\""), 8, "\"bonded\"\nadhesion = 5.0e3");
+  message = input_error(plate_case("v1", adhesion));
+  EXPECT_NE(message.find("adhesion needs"), std::string::npos) << message;
 
   std::string polyline = kPlate;
   polyline.replace(polyline.find("segment = { a = [1.0, 1.0], b = [0.0, 1.0] }"), 44,
