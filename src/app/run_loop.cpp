@@ -412,6 +412,7 @@ int run_loop(const LoopInput& in) {
           {"method", pressure->implicit_faces() ? "bicgstab" : "conjugate_gradient"},
           {"implicit_face_nodes", pressure->implicit_faces() ? pressure->impermeable_stress_face_nodes() : 0},
           {"undrained_courant", pressure->undrained_courant()},
+          {"filter_quadratic_fit_nodes", pressure->filter_fitted_rows()},
           {"tolerance", setup.fluid.tolerance},
           {"unknowns", pressure->solver().unknowns()},
           {"solves", ps.solves},

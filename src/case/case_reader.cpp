@@ -272,6 +272,16 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     c.fluid.filter = s->number("pressure_filter", 0.5);
     s->require(c.fluid.filter >= 0.0 && c.fluid.filter <= 10.0, "pressure_filter",
                fmt::format("must lie in [0, 10] (a multiple of S_w dt/rho), got {}", c.fluid.filter));
+    const std::string filter_gradient = s->string("pressure_filter_gradient", "quadratic_drained");
+    if (filter_gradient == "quadratic_drained")
+      c.fluid.filter_gradient = FluidSpec::FilterGradient::quadratic_drained;
+    else if (filter_gradient == "quadratic")
+      c.fluid.filter_gradient = FluidSpec::FilterGradient::quadratic;
+    else if (filter_gradient == "linear")
+      c.fluid.filter_gradient = FluidSpec::FilterGradient::linear;
+    else
+      s->fail("pressure_filter_gradient",
+              fmt::format("unknown value '{}' (known: quadratic_drained, quadratic, linear)", filter_gradient));
     const std::string scheme = s->string("scheme", "staggered");
     if (scheme == "staggered")
       c.layout = ParticleLayout::staggered;

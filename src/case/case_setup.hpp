@@ -121,6 +121,12 @@ struct FluidSpec {
   /// solver.pressure_filter: coefficient of the linear-exact pressure filter, in units of the
   /// fractional-step stabilisation S_w dt/rho (0 = none; method-notes §2.4).
   double filter = 0.5;
+  /// solver.pressure_filter_gradient: the gradient in the filter's psi_IJ (method-notes eq.
+  /// (2.4.18)). quadratic_drained (default): exact for quadratic fields on the rows whose support
+  /// holds a drained node, so that the filter does not drain the curved pressure there; quadratic:
+  /// on every row; linear: the velocity correction's linear-exact gradient everywhere.
+  enum class FilterGradient { quadratic_drained, quadratic, linear };
+  FilterGradient filter_gradient = FilterGradient::quadratic_drained;
   double initial_pore_pressure = 0.0;  // Pa, uniform
   /// 1/Q* = S_w n / K_f + (1 - n)/K_s (method-notes §1.4), 1/Pa
   double inverse_storage() const {

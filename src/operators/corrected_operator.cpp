@@ -428,6 +428,125 @@ void rebuild_corrected_operator(const Relation<Dim>& candidates, const std::vect
   op.degenerate_rows = degenerate.load();
 }
 
+template <int Dim>
+CorrectedOperator<Dim> quadratic_exact_gradient(const CorrectedOperator<Dim>& op, const std::vector<Vec<Dim>>& targets,
+                                                const ParticleSet<Dim>& sources, const CubicSplineKernel<Dim>& kernel,
+                                                double lattice_spacing, const std::vector<char>* fit_rows,
+                                                Index* replaced) {
+  // Basis in units of h, xi = (x_b - x_a)/h: [1, xi_d, xi_d xi_e (d <= e)] (Q terms) and, on a
+  // lattice, the odd-even mode (-1)^(sum_d i_d) (i_d the lattice offset of b from a), so that the
+  // fitted gradient is blind to it as a full support's symmetric one is (eq. (2.4.18)).
+  constexpr int Q = 1 + Dim + Dim * (Dim + 1) / 2;
+  constexpr int QMax = Q + 1;
+  using MatQ = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, QMax, QMax>;
+  using VecQ = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, QMax, 1>;
+  const bool odd_even = lattice_spacing > 0.0;
+  const int nb = odd_even ? QMax : Q;
+  const double h = kernel.h();
+  auto basis = [&](const Vec<Dim>& x_ba) {
+    VecQ p(nb);
+    const Vec<Dim> xi = x_ba / h;
+    p[0] = 1.0;
+    int m = 1;
+    for (int d = 0; d < Dim; ++d) p[m++] = xi[d];
+    for (int d = 0; d < Dim; ++d) {
+      for (int e = d; e < Dim; ++e) p[m++] = xi[d] * xi[e];
+    }
+    if (odd_even) {
+      long parity = 0;
+      for (int d = 0; d < Dim; ++d) parity += std::lround(x_ba[d] / lattice_spacing);
+      p[m] = parity % 2 == 0 ? 1.0 : -1.0;
+    }
+    return p;
+  };
+  CorrectedOperator<Dim> out = op;
+  const Index np = op.patterns();
+  auto selected = [&](Index a) { return fit_rows == nullptr || (*fit_rows)[static_cast<std::size_t>(a)] != 0; };
+  // Per pattern, a representative among the selected rows, and whether unselected rows share it.
+  std::vector<Index> representative(static_cast<std::size_t>(np), -1);
+  std::vector<char> mixed(static_cast<std::size_t>(np), 0);
+  for (Index a = 0; a < op.rows(); ++a) {
+    const auto p = static_cast<std::size_t>(op.pattern[static_cast<std::size_t>(a)]);
+    if (selected(a)) {
+      if (representative[p] < 0) representative[p] = a;
+    } else {
+      mixed[p] = 1;
+    }
+  }
+  // A pattern shared by selected and unselected rows is split: the selected rows move to a copy
+  // of it, fitted below (rows then run one by one: the runs of op assume one pattern per run).
+  std::vector<Index> moved_to(static_cast<std::size_t>(np), -1);
+  for (Index p = 0; p < np; ++p) {
+    if (representative[static_cast<std::size_t>(p)] < 0 || mixed[static_cast<std::size_t>(p)] == 0) continue;
+    const Index begin = op.pattern_start[static_cast<std::size_t>(p)], end = op.pattern_start[static_cast<std::size_t>(p) + 1];
+    moved_to[static_cast<std::size_t>(p)] = out.patterns();
+    for (Index k = begin; k < end; ++k) {
+      out.offset.push_back(op.offset[static_cast<std::size_t>(k)]);
+      out.interp.push_back(op.interp[static_cast<std::size_t>(k)]);
+      out.grad.push_back(op.grad[static_cast<std::size_t>(k)]);
+    }
+    out.pattern_start.push_back(static_cast<Index>(out.offset.size()));
+  }
+  if (fit_rows != nullptr) {
+    for (Index a = 0; a < op.rows(); ++a) {
+      const auto p = static_cast<std::size_t>(op.pattern[static_cast<std::size_t>(a)]);
+      if (moved_to[p] >= 0 && selected(a)) out.pattern[static_cast<std::size_t>(a)] = moved_to[p];
+    }
+    out.run_start.resize(static_cast<std::size_t>(op.rows()) + 1);
+    for (Index a = 0; a <= op.rows(); ++a) out.run_start[static_cast<std::size_t>(a)] = a;
+  }
+  std::vector<char> fitted(static_cast<std::size_t>(np), 0);
+  for (Index p = 0; p < np; ++p) {
+    const Index a = representative[static_cast<std::size_t>(p)];
+    if (a < 0) continue;
+    const auto r = op.row(a);
+    const Vec<Dim>& xa = targets[static_cast<std::size_t>(a)];
+    // op's own weights are kept where they are exact for the quadratics and blind to the odd-even
+    // mode (sum_b h g_ab,d m(xi_b) = 0 for those basis terms m, to round-off): a full support.
+    double defect = 0.0;
+    for (int d = 0; d < Dim; ++d) {
+      VecQ moment = VecQ::Zero(nb);
+      for (Index k = r.begin; k < r.end; ++k) {
+        moment += h * op.grad[static_cast<std::size_t>(k)][static_cast<std::size_t>(d)] *
+                  basis(sources.position[static_cast<std::size_t>(op.source(r, k))] - xa);
+      }
+      defect = std::max(defect, moment.tail(nb - 1 - Dim).cwiseAbs().maxCoeff());
+    }
+    if (defect < 1e-9) continue;
+    MatQ M = MatQ::Zero(nb, nb);
+    for (Index k = r.begin; k < r.end; ++k) {
+      const auto b = static_cast<std::size_t>(op.source(r, k));
+      const VecQ pb = basis(sources.position[b] - xa);
+      M += sources.volume[b] * kernel.value((sources.position[b] - xa).norm()) * pb * pb.transpose();
+    }
+    // M is symmetric positive semi-definite; a tiny smallest eigenvalue against the largest
+    // means the sources do not determine the fit (too few, or on a line): keep op's weights.
+    const Eigen::SelfAdjointEigenSolver<MatQ> eig(M);
+    const double lmax = eig.eigenvalues().maxCoeff(), lmin = eig.eigenvalues().minCoeff();
+    if (!(lmax > 0.0) || lmin < 1e-10 * lmax) continue;
+    const MatQ Minv = eig.eigenvectors() * eig.eigenvalues().cwiseInverse().asDiagonal() * eig.eigenvectors().transpose();
+    const Index shift = moved_to[static_cast<std::size_t>(p)] >= 0
+                            ? out.pattern_start[static_cast<std::size_t>(moved_to[static_cast<std::size_t>(p)])] - r.begin
+                            : 0;
+    for (Index k = r.begin; k < r.end; ++k) {
+      const auto b = static_cast<std::size_t>(op.source(r, k));
+      const double w = sources.volume[b] * kernel.value((sources.position[b] - xa).norm());
+      const VecQ c = Minv * basis(sources.position[b] - xa) * w;
+      for (int d = 0; d < Dim; ++d) {
+        out.grad[static_cast<std::size_t>(k + shift)][static_cast<std::size_t>(d)] = c[1 + d] / h;
+      }
+    }
+    fitted[static_cast<std::size_t>(p)] = 1;
+  }
+  if (replaced != nullptr) {
+    *replaced = 0;
+    for (Index a = 0; a < op.rows(); ++a) {
+      if (selected(a)) *replaced += fitted[static_cast<std::size_t>(op.pattern[static_cast<std::size_t>(a)])];
+    }
+  }
+  return out;
+}
+
 #define RKTSPH_INSTANTIATE(D)                                                                                        \
   template RelationOptions operator_relation_options<D>(const CubicSplineKernel<D>&);                                \
   template CorrectedOperator<D> build_corrected_operator<D>(const Relation<D>&, const std::vector<Vec<D>>&,          \
@@ -437,7 +556,10 @@ void rebuild_corrected_operator(const Relation<Dim>& candidates, const std::vect
                                                             const CubicSplineKernel<D>&, const OperatorOptions&);    \
   template void rebuild_corrected_operator<D>(const Relation<D>&, const std::vector<Vec<D>>&, const ParticleSet<D>&, \
                                               const CubicSplineKernel<D>&, CorrectedOperator<D>&,                    \
-                                              const exec::Threads&);
+                                              const exec::Threads&);                                 \
+  template CorrectedOperator<D> quadratic_exact_gradient<D>(const CorrectedOperator<D>&, const std::vector<Vec<D>>&, \
+                                                            const ParticleSet<D>&, const CubicSplineKernel<D>&,      \
+                                                            double, const std::vector<char>*, Index*);
 RKTSPH_INSTANTIATE(1)
 RKTSPH_INSTANTIATE(2)
 RKTSPH_INSTANTIATE(3)

@@ -128,6 +128,24 @@ void rebuild_corrected_operator(const Relation<Dim>& candidates, const std::vect
                                 const ParticleSet<Dim>& sources, const CubicSplineKernel<Dim>& kernel,
                                 CorrectedOperator<Dim>& op, const exec::Threads& policy = {});
 
+/// The gradient of `op` made exact for quadratic fields on every row (the pressure filter's
+/// gradient, method-notes eq. (2.4.11)): a pattern whose weights already are (a full support on a
+/// lattice, by symmetry) is kept as it is; on the others (truncated supports: faces, corners,
+/// jittered sets) the gradient weights are those of a least-squares fit of the quadratic
+/// polynomials weighted by V_b W_ab over the same sources (eq. (2.4.18)), with the lattice's
+/// odd-even mode as one more basis function when `lattice_spacing` > 0 (so that the gradient does
+/// not mistake that mode for a curved field on a one-sided support). A pattern whose fit
+/// is ill-conditioned (too few sources) keeps op's linear-exact weights. Rows that share a
+/// pattern share their geometry, so each pattern is fitted once. `fit_rows`, if given, selects
+/// the rows that may be fitted (non-zero entries; a pattern shared with unselected rows is split,
+/// and the result then runs row by row). `replaced`, if given, receives the number of rows whose
+/// weights were replaced.
+template <int Dim>
+CorrectedOperator<Dim> quadratic_exact_gradient(const CorrectedOperator<Dim>& op, const std::vector<Vec<Dim>>& targets,
+                                                const ParticleSet<Dim>& sources, const CubicSplineKernel<Dim>& kernel,
+                                                double lattice_spacing, const std::vector<char>* fit_rows = nullptr,
+                                                Index* replaced = nullptr);
+
 /// Difference-form gradients at `targets` over `relation` (built with
 /// difference_gradient_relation_options, one row per target).
 template <int Dim>

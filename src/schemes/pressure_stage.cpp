@@ -112,7 +112,35 @@ PorePressureStage<Dim>::PorePressureStage(StaggeredModel<Dim>& model) : m_(model
     // quadratic) pressure fields that loads impose at impermeable walls.
     s.filter = fl.filter * fl.saturation * stabilisation_time_ / rho;
     const NodeLaplacianPatterns plain = build_node_laplacian_patterns<Dim>(relation, nodes, m_.kernel, {}, {}, false);
-    const PatternMatrix tg = build_filter_gradient_patterns<Dim>(plain.symmetric, nodes.position, node_operator_);
+    // The filter's gradient exact for quadratics on the truncated rows too (eq. (2.4.18)): with
+    // the linear-exact one, psi_IJ is O(h^2 p'') there, and the filter drains the curved pressure
+    // next to a drained face at a rate set by dt, not k (Mandel's problem, late times).
+    PatternMatrix tg;
+    using FilterGradient = FluidSpec::FilterGradient;
+    if (fl.filter_gradient != FilterGradient::linear) {
+      // quadratic_drained: the rows whose support holds a drained node (there the pressure is
+      // pinned and its boundary layer curved; at impermeable faces the fit gains nothing and its
+      // odd-even column makes the filter act harder on a shear band's pressure, VALIDATION.md).
+      std::vector<char> near_drained;
+      if (fl.filter_gradient == FilterGradient::quadratic_drained) {
+        near_drained.assign(static_cast<std::size_t>(nn), 0);
+        for (Index i = 0; i < static_cast<Index>(nn); ++i) {
+          const auto r = node_operator_.row(i);
+          for (Index k = r.begin; k < r.end; ++k) {
+            if (conditions_.drained[static_cast<std::size_t>(node_operator_.source(r, k))]) {
+              near_drained[static_cast<std::size_t>(i)] = 1;
+              break;
+            }
+          }
+        }
+      }
+      const CorrectedOperator<Dim> quadratic = quadratic_exact_gradient<Dim>(
+          node_operator_, nodes.position, nodes, m_.kernel, m_.dx(),
+          fl.filter_gradient == FilterGradient::quadratic_drained ? &near_drained : nullptr, &filter_fitted_rows_);
+      tg = build_filter_gradient_patterns<Dim>(plain.symmetric, nodes.position, quadratic);
+    } else {
+      tg = build_filter_gradient_patterns<Dim>(plain.symmetric, nodes.position, node_operator_);
+    }
     solver_ =
         std::make_unique<PorePressureSolver>(lap.full, lap.symmetric, conditions_.drained, s, &plain.symmetric, &tg, coupling);
   } else {

@@ -54,6 +54,9 @@ class PorePressureStage final : public Stage {
   Index impermeable_stress_face_nodes() const { return impermeable_stress_faces_; }
   /// Those faces are taken implicitly (solver.pressure_faces = "implicit"): the limit is gone.
   bool implicit_faces() const { return !face_coupling_.empty(); }
+  /// Nodes whose pressure-filter gradient was fitted to quadratics (truncated supports;
+  /// solver.pressure_filter_gradient = "quadratic"), for the log.
+  Index filter_fitted_rows() const { return filter_fitted_rows_; }
   static constexpr double kUndrainedCourantLimit = 3.5;
   /// solver.pressure_faces = "auto" takes the faces implicitly above this C c_u/c_d (a margin
   /// below the measured limit: stable at 2.7, 2.9, 3.4; unstable at 3.6).
@@ -92,6 +95,7 @@ class PorePressureStage final : public Stage {
   double stabilisation_time_ = 0.0;  // dt (method-notes §2.4) or dt/2 (stress-point divergence)
   double undrained_courant_ = 0.0;
   Index impermeable_stress_faces_ = 0;
+  Index filter_fitted_rows_ = 0;
   double seconds_ = 0.0;
 };
 

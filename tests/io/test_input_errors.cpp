@@ -163,6 +163,14 @@ TEST(InputErrors, PressureFilterOutOfRange) {
   expect_error_at(o, line_of(text, "pressure_filter"), "solver.pressure_filter", {"[0, 10]"});
 }
 
+TEST(InputErrors, UnknownPressureFilterGradient) {
+  test::TempDir dir;
+  const std::string text = replace(kBase, "[time]", "[solver]\npressure_filter_gradient = \"cubic\"\n[time]");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "pressure_filter_gradient"), "solver.pressure_filter_gradient",
+                  {"quadratic_drained", "quadratic", "linear"});
+}
+
 TEST(InputErrors, WrongTypeOfAnArray) {
   test::TempDir dir;
   const std::string text = replace(kBase, "min = [0.0, 0.0]", "min = 0.0");

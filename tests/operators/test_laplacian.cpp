@@ -218,5 +218,96 @@ TEST(PressureFilter, VanishesForQuadraticFieldsInsideAndDampsTheCheckerboard) {
   EXPECT_GT(weakest_damping, 1.0);   // |F p| >~ |p| / dx^2 on the odd-even mode
 }
 
+// With the quadratic-exact gradient (solver.pressure_filter_gradient = "quadratic", method-notes
+// eq. (2.4.18)) psi_IJ vanishes for quadratic fields on every row, faces and corners of a
+// jittered set included, so the filter leaves a drained face's curved pressure alone; the
+// linear-exact gradient does not (that is the defect it fixes), and the odd-even mode is still
+// damped on every row.
+TEST(PressureFilter, QuadraticGradientVanishesForQuadraticFieldsOnEveryRow) {
+  for (double jitter : {0.0, 0.2}) {
+    const double dx = 0.1;
+    const auto s = lattice2(12, 12, dx, jitter);
+    const CubicSplineKernel<2> kernel(1.2 * dx);
+    const auto op = build_corrected_operator<2>(s.position, s, kernel);
+    Index fitted = 0;
+    const auto quad = quadratic_exact_gradient<2>(op, s.position, s, kernel, dx, nullptr, &fitted);
+    const auto lap = build_node_laplacian<2>(s, kernel);
+    const auto tg_linear = build_filter_gradient_part<2>(lap.symmetric, s.position, gradient_matrices<2>(op, s.size()));
+    const auto tg_quad = build_filter_gradient_part<2>(lap.symmetric, s.position, gradient_matrices<2>(quad, s.size()));
+    // Every row whose support is truncated is fitted; on the regular lattice the full rows are kept.
+    EXPECT_GT(fitted, 0);
+    if (jitter == 0.0) {
+      EXPECT_LT(fitted, s.size());
+    }
+    const Eigen::VectorXd q = sample(s, quadratic);
+    const Eigen::VectorXd lin = sample(s, linear);
+    const double scale = 4.0;  // the Laplacian of the quadratic
+    const Eigen::VectorXd fq = (lap.symmetric - tg_quad) * q;
+    const Eigen::VectorXd fl = (lap.symmetric - tg_linear) * q;
+    EXPECT_LT(fq.cwiseAbs().maxCoeff() / scale, 1e-8) << "jitter " << jitter;
+    EXPECT_GT(fl.cwiseAbs().maxCoeff() / scale, 0.1) << "jitter " << jitter;  // the linear gradient's defect
+    EXPECT_LT(((lap.symmetric - tg_quad) * lin).cwiseAbs().maxCoeff(), 1e-9 * 5.0 / (dx * dx));
+    // The checkerboard: still pulled towards its neighbours' mean on every row.
+    Eigen::VectorXd checker(s.size());
+    for (Index i = 0; i < s.size(); ++i) checker[i] = (i % 13 + i / 13) % 2 == 0 ? 1.0 : -1.0;
+    const Eigen::VectorXd c = (lap.symmetric - tg_quad) * checker;
+    double weakest = 1e300;
+    for (Index i = 0; i < s.size(); ++i) weakest = std::min(weakest, -c[i] * checker[i] * dx * dx);
+    EXPECT_GT(weakest, 0.5) << "jitter " << jitter;
+  }
+}
+
+// Only the selected rows are fitted (the rows near a drained face): a pattern that they share
+// with unselected rows (the bottom face's rows left and right of x = 0.5) is split, the
+// unselected rows keep the linear-exact weights bit for bit.
+TEST(PressureFilter, QuadraticGradientFitsOnlyTheSelectedRows) {
+  const double dx = 0.1;
+  const auto s = lattice2(12, 12, dx, 0.0);
+  const CubicSplineKernel<2> kernel(1.2 * dx);
+  const auto op = build_corrected_operator<2>(s.position, s, kernel);
+  std::vector<char> select(static_cast<std::size_t>(s.size()), 0);
+  for (Index i = 0; i < s.size(); ++i) select[static_cast<std::size_t>(i)] = s.position[static_cast<std::size_t>(i)][0] < 0.55;
+  Index fitted = 0;
+  const auto quad = quadratic_exact_gradient<2>(op, s.position, s, kernel, dx, &select, &fitted);
+  EXPECT_GT(fitted, 0);
+  for (Index i = 0; i < s.size(); ++i) {
+    const auto& x = s.position[static_cast<std::size_t>(i)];
+    // The gradient of x^2 + y^2 at row i from each operator, against 2x.
+    Vec<2> g_op = Vec<2>::Zero(), g_quad = Vec<2>::Zero();
+    const auto ro = op.row(i), rq = quad.row(i);
+    ASSERT_EQ(ro.end - ro.begin, rq.end - rq.begin);
+    for (Index k = 0; k < ro.end - ro.begin; ++k) {
+      const double f = quadratic(s.position[static_cast<std::size_t>(op.source(ro, ro.begin + k))]);
+      ASSERT_EQ(op.source(ro, ro.begin + k), quad.source(rq, rq.begin + k));
+      for (int d = 0; d < 2; ++d) {
+        g_op[d] += op.grad[static_cast<std::size_t>(ro.begin + k)][static_cast<std::size_t>(d)] * f;
+        g_quad[d] += quad.grad[static_cast<std::size_t>(rq.begin + k)][static_cast<std::size_t>(d)] * f;
+      }
+    }
+    if (select[static_cast<std::size_t>(i)] != 0) {
+      EXPECT_LT((g_quad - 2.0 * x).norm(), 1e-9) << "row " << i;
+    } else {
+      EXPECT_EQ(g_quad, g_op) << "row " << i;
+    }
+  }
+}
+
+// Where the corrected gradient is already exact for quadratics (a full support on a lattice)
+// its weights are kept bit for bit.
+TEST(PressureFilter, QuadraticGradientKeepsTheInteriorWeights) {
+  const double dx = 0.1;
+  const auto s = lattice2(14, 14, dx, 0.0);
+  const CubicSplineKernel<2> kernel(1.2 * dx);
+  const auto op = build_corrected_operator<2>(s.position, s, kernel);
+  const auto quad = quadratic_exact_gradient<2>(op, s.position, s, kernel, dx);
+  ASSERT_EQ(quad.grad.size(), op.grad.size());
+  const Index centre = 7 * 15 + 7;  // a 15 x 15 lattice
+  const auto r = op.row(centre);
+  for (Index k = r.begin; k < r.end; ++k) {
+    EXPECT_EQ(quad.grad[static_cast<std::size_t>(k)][0], op.grad[static_cast<std::size_t>(k)][0]);
+    EXPECT_EQ(quad.grad[static_cast<std::size_t>(k)][1], op.grad[static_cast<std::size_t>(k)][1]);
+  }
+}
+
 }  // namespace
 }  // namespace rktsph
