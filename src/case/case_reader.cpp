@@ -269,7 +269,7 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
       c.fluid.face_condition = FluidSpec::FaceCondition::explicit_p;
     else
       s->fail("pressure_faces", fmt::format("unknown value '{}' (known: auto, implicit, explicit)", faces));
-    c.fluid.filter = s->number("pressure_filter", 0.5);
+    c.fluid.filter = s->number("pressure_filter", 0.0);
     s->require(c.fluid.filter >= 0.0 && c.fluid.filter <= 10.0, "pressure_filter",
                fmt::format("must lie in [0, 10] (a multiple of S_w dt/rho), got {}", c.fluid.filter));
     const std::string filter_gradient = s->string("pressure_filter_gradient", "quadratic_drained");
@@ -282,6 +282,10 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     else
       s->fail("pressure_filter_gradient",
               fmt::format("unknown value '{}' (known: quadratic_drained, quadratic, linear)", filter_gradient));
+    c.fluid.odd_even_filter = s->number("pressure_odd_even_filter", 0.5);
+    s->require(c.fluid.odd_even_filter >= 0.0 && c.fluid.odd_even_filter <= 1.0, "pressure_odd_even_filter",
+               fmt::format("must lie in [0, 1] (the fraction of the odd-even amplitude removed a step), got {}",
+                           c.fluid.odd_even_filter));
     const std::string scheme = s->string("scheme", "staggered");
     if (scheme == "staggered")
       c.layout = ParticleLayout::staggered;

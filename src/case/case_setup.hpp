@@ -119,14 +119,17 @@ struct FluidSpec {
   enum class FaceCondition { automatic, implicit, explicit_p };
   FaceCondition face_condition = FaceCondition::automatic;
   /// solver.pressure_filter: coefficient of the linear-exact pressure filter, in units of the
-  /// fractional-step stabilisation S_w dt/rho (0 = none; method-notes §2.4).
-  double filter = 0.5;
+  /// fractional-step stabilisation S_w dt/rho (0 = none, the default; method-notes §2.4).
+  double filter = 0.0;
   /// solver.pressure_filter_gradient: the gradient in the filter's psi_IJ (method-notes eq.
   /// (2.4.18)). quadratic_drained (default): exact for quadratic fields on the rows whose support
   /// holds a drained node, so that the filter does not drain the curved pressure there; quadratic:
   /// on every row; linear: the velocity correction's linear-exact gradient everywhere.
   enum class FilterGradient { quadratic_drained, quadratic, linear };
   FilterGradient filter_gradient = FilterGradient::quadratic_drained;
+  /// solver.pressure_odd_even_filter: the fraction alpha of the local odd-even amplitude taken
+  /// off p_w after each solve, p <- p - alpha a (method-notes eq. (2.4.19)); 0 = off.
+  double odd_even_filter = 0.5;
   double initial_pore_pressure = 0.0;  // Pa, uniform
   /// 1/Q* = S_w n / K_f + (1 - n)/K_s (method-notes §1.4), 1/Pa
   double inverse_storage() const {

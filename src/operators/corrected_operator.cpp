@@ -428,37 +428,76 @@ void rebuild_corrected_operator(const Relation<Dim>& candidates, const std::vect
   op.degenerate_rows = degenerate.load();
 }
 
+namespace {
+
+// The least-squares basis of eq. (2.4.18) in units of h, xi = (x_b - x_a)/h: [1, xi_d,
+// xi_d xi_e (d <= e)] (Q terms) and, on a lattice, the odd-even mode (-1)^(sum_d i_d), i_d the
+// lattice offset of b from a.
 template <int Dim>
-CorrectedOperator<Dim> quadratic_exact_gradient(const CorrectedOperator<Dim>& op, const std::vector<Vec<Dim>>& targets,
-                                                const ParticleSet<Dim>& sources, const CubicSplineKernel<Dim>& kernel,
-                                                double lattice_spacing, const std::vector<char>* fit_rows,
-                                                Index* replaced) {
-  // Basis in units of h, xi = (x_b - x_a)/h: [1, xi_d, xi_d xi_e (d <= e)] (Q terms) and, on a
-  // lattice, the odd-even mode (-1)^(sum_d i_d) (i_d the lattice offset of b from a), so that the
-  // fitted gradient is blind to it as a full support's symmetric one is (eq. (2.4.18)).
-  constexpr int Q = 1 + Dim + Dim * (Dim + 1) / 2;
-  constexpr int QMax = Q + 1;
-  using MatQ = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, QMax, QMax>;
-  using VecQ = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, QMax, 1>;
-  const bool odd_even = lattice_spacing > 0.0;
-  const int nb = odd_even ? QMax : Q;
-  const double h = kernel.h();
-  auto basis = [&](const Vec<Dim>& x_ba) {
-    VecQ p(nb);
-    const Vec<Dim> xi = x_ba / h;
+struct QuadraticBasis {
+  static constexpr int Q = 1 + Dim + Dim * (Dim + 1) / 2;
+  static constexpr int Modes = (1 << Dim) - 1;  // (-1)^(sum over a non-empty subset of axes)
+  static constexpr int QMax = Q + Modes;
+  using Mat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, QMax, QMax>;
+  using Vec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, QMax, 1>;
+  double h;
+  double spacing;         // 0: no odd-even column
+  bool all_modes = false;  // false: the diagonal mode (every axis) only
+  int modes() const { return spacing > 0.0 ? (all_modes ? Modes : 1) : 0; }
+  int size() const { return Q + modes(); }
+  Vec operator()(const rktsph::Vec<Dim>& x_ba) const {
+    Vec p(size());
+    const rktsph::Vec<Dim> xi = x_ba / h;
     p[0] = 1.0;
     int m = 1;
     for (int d = 0; d < Dim; ++d) p[m++] = xi[d];
     for (int d = 0; d < Dim; ++d) {
       for (int e = d; e < Dim; ++e) p[m++] = xi[d] * xi[e];
     }
-    if (odd_even) {
-      long parity = 0;
-      for (int d = 0; d < Dim; ++d) parity += std::lround(x_ba[d] / lattice_spacing);
-      p[m] = parity % 2 == 0 ? 1.0 : -1.0;
+    if (spacing > 0.0) {
+      long offset[Dim];
+      for (int d = 0; d < Dim; ++d) offset[d] = std::lround(x_ba[d] / spacing);
+      // The diagonal mode first (subset = every axis), then the others.
+      for (int subset = (1 << Dim) - 1; subset >= 1 && m < size(); --subset) {
+        long parity = 0;
+        for (int d = 0; d < Dim; ++d) parity += (subset >> d & 1) != 0 ? offset[d] : 0;
+        p[m++] = parity % 2 == 0 ? 1.0 : -1.0;
+      }
     }
     return p;
-  };
+  }
+  // (sum_b w_b P_b P_b^T)^{-1} over row r of op, w_b = V_b W_ab; false if the sources do not
+  // determine the fit (smallest eigenvalue below 1e-10 of the largest: too few, or on a line).
+  bool inverse_moments(const CorrectedOperator<Dim>& op, const typename CorrectedOperator<Dim>::Row& r,
+                       const rktsph::Vec<Dim>& xa, const ParticleSet<Dim>& sources,
+                       const CubicSplineKernel<Dim>& kernel, Mat& inverse) const {
+    Mat M = Mat::Zero(size(), size());
+    for (Index k = r.begin; k < r.end; ++k) {
+      const auto b = static_cast<std::size_t>(op.source(r, k));
+      const Vec pb = (*this)(sources.position[b] - xa);
+      M += sources.volume[b] * kernel.value((sources.position[b] - xa).norm()) * pb * pb.transpose();
+    }
+    const Eigen::SelfAdjointEigenSolver<Mat> eig(M);
+    const double lmax = eig.eigenvalues().maxCoeff(), lmin = eig.eigenvalues().minCoeff();
+    if (!(lmax > 0.0) || lmin < 1e-10 * lmax) return false;
+    inverse = eig.eigenvectors() * eig.eigenvalues().cwiseInverse().asDiagonal() * eig.eigenvectors().transpose();
+    return true;
+  }
+};
+
+}  // namespace
+
+template <int Dim>
+CorrectedOperator<Dim> quadratic_exact_gradient(const CorrectedOperator<Dim>& op, const std::vector<Vec<Dim>>& targets,
+                                                const ParticleSet<Dim>& sources, const CubicSplineKernel<Dim>& kernel,
+                                                double lattice_spacing, const std::vector<char>* fit_rows,
+                                                Index* replaced) {
+  // The fit of eq. (2.4.18); the odd-even column keeps the fitted gradient blind to that mode,
+  // as a full support's symmetric one is.
+  using Basis = QuadraticBasis<Dim>;
+  const Basis basis{kernel.h(), lattice_spacing};
+  const int nb = basis.size();
+  const double h = kernel.h();
   CorrectedOperator<Dim> out = op;
   const Index np = op.patterns();
   auto selected = [&](Index a) { return fit_rows == nullptr || (*fit_rows)[static_cast<std::size_t>(a)] != 0; };
@@ -505,7 +544,7 @@ CorrectedOperator<Dim> quadratic_exact_gradient(const CorrectedOperator<Dim>& op
     // mode (sum_b h g_ab,d m(xi_b) = 0 for those basis terms m, to round-off): a full support.
     double defect = 0.0;
     for (int d = 0; d < Dim; ++d) {
-      VecQ moment = VecQ::Zero(nb);
+      typename Basis::Vec moment = Basis::Vec::Zero(nb);
       for (Index k = r.begin; k < r.end; ++k) {
         moment += h * op.grad[static_cast<std::size_t>(k)][static_cast<std::size_t>(d)] *
                   basis(sources.position[static_cast<std::size_t>(op.source(r, k))] - xa);
@@ -513,25 +552,15 @@ CorrectedOperator<Dim> quadratic_exact_gradient(const CorrectedOperator<Dim>& op
       defect = std::max(defect, moment.tail(nb - 1 - Dim).cwiseAbs().maxCoeff());
     }
     if (defect < 1e-9) continue;
-    MatQ M = MatQ::Zero(nb, nb);
-    for (Index k = r.begin; k < r.end; ++k) {
-      const auto b = static_cast<std::size_t>(op.source(r, k));
-      const VecQ pb = basis(sources.position[b] - xa);
-      M += sources.volume[b] * kernel.value((sources.position[b] - xa).norm()) * pb * pb.transpose();
-    }
-    // M is symmetric positive semi-definite; a tiny smallest eigenvalue against the largest
-    // means the sources do not determine the fit (too few, or on a line): keep op's weights.
-    const Eigen::SelfAdjointEigenSolver<MatQ> eig(M);
-    const double lmax = eig.eigenvalues().maxCoeff(), lmin = eig.eigenvalues().minCoeff();
-    if (!(lmax > 0.0) || lmin < 1e-10 * lmax) continue;
-    const MatQ Minv = eig.eigenvectors() * eig.eigenvalues().cwiseInverse().asDiagonal() * eig.eigenvectors().transpose();
+    typename Basis::Mat Minv;
+    if (!basis.inverse_moments(op, r, xa, sources, kernel, Minv)) continue;
     const Index shift = moved_to[static_cast<std::size_t>(p)] >= 0
                             ? out.pattern_start[static_cast<std::size_t>(moved_to[static_cast<std::size_t>(p)])] - r.begin
                             : 0;
     for (Index k = r.begin; k < r.end; ++k) {
       const auto b = static_cast<std::size_t>(op.source(r, k));
       const double w = sources.volume[b] * kernel.value((sources.position[b] - xa).norm());
-      const VecQ c = Minv * basis(sources.position[b] - xa) * w;
+      const typename Basis::Vec c = Minv * basis(sources.position[b] - xa) * w;
       for (int d = 0; d < Dim; ++d) {
         out.grad[static_cast<std::size_t>(k + shift)][static_cast<std::size_t>(d)] = c[1 + d] / h;
       }
@@ -542,6 +571,61 @@ CorrectedOperator<Dim> quadratic_exact_gradient(const CorrectedOperator<Dim>& op
     *replaced = 0;
     for (Index a = 0; a < op.rows(); ++a) {
       if (selected(a)) *replaced += fitted[static_cast<std::size_t>(op.pattern[static_cast<std::size_t>(a)])];
+    }
+  }
+  return out;
+}
+
+template <int Dim>
+CorrectedOperator<Dim> odd_even_amplitude(const CorrectedOperator<Dim>& op, const std::vector<Vec<Dim>>& targets,
+                                          const ParticleSet<Dim>& sources, const CubicSplineKernel<Dim>& kernel,
+                                          double lattice_spacing, Index* undetermined) {
+  if (!(lattice_spacing > 0.0)) throw SolverError("odd-even amplitude: needs the lattice spacing");
+  using Basis = QuadraticBasis<Dim>;
+  const Basis basis{kernel.h(), lattice_spacing, true};
+  CorrectedOperator<Dim> out = op;
+  std::fill(out.interp.begin(), out.interp.end(), 0.0);
+  const Index np = op.patterns();
+  std::vector<Index> representative(static_cast<std::size_t>(np), -1);
+  for (Index a = 0; a < op.rows(); ++a) {
+    Index& r = representative[static_cast<std::size_t>(op.pattern[static_cast<std::size_t>(a)])];
+    if (r < 0) r = a;
+  }
+  std::vector<char> determined(static_cast<std::size_t>(np), 0);
+  for (Index p = 0; p < np; ++p) {
+    const Index a = representative[static_cast<std::size_t>(p)];
+    if (a < 0) continue;
+    const auto r = op.row(a);
+    const Vec<Dim>& xa = targets[static_cast<std::size_t>(a)];
+    // The amplitude weights: the sum of the odd-even coefficients of the fit (each mode is 1 at
+    // the target), so that a_a = p_a on a pure mode. Where the sources span fewer than three
+    // lattice levels beyond the target along an axis (rows next to a face), the mode along that
+    // axis is a parabola there (1, -1, 1 = 1 - 4i + 2i^2) and the full fit is singular: such a
+    // row takes the diagonal mode alone (it is no null mode of the one-sided operators anyway).
+    // A guard against rows where a mode is barely separable from the quadratics: sum |w| > 4,
+    // a would amplify the other content.
+    auto try_fit = [&](const Basis& fit) {
+      typename Basis::Mat Minv;
+      if (!fit.inverse_moments(op, r, xa, sources, kernel, Minv)) return false;
+      double total = 0.0;
+      for (Index k = r.begin; k < r.end; ++k) {
+        const auto b = static_cast<std::size_t>(op.source(r, k));
+        const double w = sources.volume[b] * kernel.value((sources.position[b] - xa).norm());
+        const double c = (Minv * fit(sources.position[b] - xa)).tail(fit.modes()).sum() * w;
+        out.interp[static_cast<std::size_t>(k)] = c;
+        total += std::abs(c);
+      }
+      if (total <= 4.0) return true;
+      for (Index k = r.begin; k < r.end; ++k) out.interp[static_cast<std::size_t>(k)] = 0.0;
+      return false;
+    };
+    if (!try_fit(basis) && !try_fit(Basis{kernel.h(), lattice_spacing, false})) continue;
+    determined[static_cast<std::size_t>(p)] = 1;
+  }
+  if (undetermined != nullptr) {
+    *undetermined = 0;
+    for (Index a = 0; a < op.rows(); ++a) {
+      *undetermined += determined[static_cast<std::size_t>(op.pattern[static_cast<std::size_t>(a)])] == 0 ? 1 : 0;
     }
   }
   return out;
@@ -559,7 +643,10 @@ CorrectedOperator<Dim> quadratic_exact_gradient(const CorrectedOperator<Dim>& op
                                               const exec::Threads&);                                 \
   template CorrectedOperator<D> quadratic_exact_gradient<D>(const CorrectedOperator<D>&, const std::vector<Vec<D>>&, \
                                                             const ParticleSet<D>&, const CubicSplineKernel<D>&,      \
-                                                            double, const std::vector<char>*, Index*);
+                                                            double, const std::vector<char>*, Index*);          \
+  template CorrectedOperator<D> odd_even_amplitude<D>(const CorrectedOperator<D>&, const std::vector<Vec<D>>&,       \
+                                                      const ParticleSet<D>&, const CubicSplineKernel<D>&, double,    \
+                                                      Index*);
 RKTSPH_INSTANTIATE(1)
 RKTSPH_INSTANTIATE(2)
 RKTSPH_INSTANTIATE(3)

@@ -147,6 +147,15 @@ PorePressureStage<Dim>::PorePressureStage(StaggeredModel<Dim>& model) : m_(model
     solver_ = std::make_unique<PorePressureSolver>(lap.full, lap.symmetric, conditions_.drained, s, nullptr, nullptr,
                                                    coupling);
   }
+  if (fl.odd_even_filter > 0.0) {
+    if (!(m_.dx() > 0.0)) {
+      throw InputError(fmt::format("{}: solver.pressure_odd_even_filter needs the nodes on a lattice of known spacing "
+                                   "(geometry.spacing); set it to 0 and use solver.pressure_filter instead",
+                                   m_.setup.file));
+    }
+    odd_even_ = odd_even_amplitude<Dim>(node_operator_, nodes.position, nodes, m_.kernel, m_.dx());
+    odd_even_amplitude_.assign(nn, 0.0);
+  }
   if (m_.plates != nullptr && m_.plates->any_force()) {
     if (fl.divergence_from_stress_points) {
       throw InputError(fmt::format(
@@ -311,8 +320,10 @@ void PorePressureStage<Dim>::load(const io::StateArchive& a, const std::string& 
 
 template <int Dim>
 std::size_t PorePressureStage<Dim>::scratch_bytes() const {
-  return (p_old_.size() + source_.size() + pressure_gradient_.size() + skeleton_.size()) * sizeof(double) +
-         node_operator_.bytes() + (solver_ != nullptr ? solver_->bytes() : 0) + face_coupling_.bytes();
+  return (p_old_.size() + source_.size() + pressure_gradient_.size() + skeleton_.size() + odd_even_amplitude_.size()) *
+             sizeof(double) +
+         node_operator_.bytes() + (odd_even_amplitude_.empty() ? 0 : odd_even_.bytes()) +
+         (solver_ != nullptr ? solver_->bytes() : 0) + face_coupling_.bytes();
 }
 
 template <int Dim>
@@ -406,6 +417,22 @@ void PorePressureStage<Dim>::run(const StepContext& context) {
     });
   }
   solve_with_bodies();
+  if (!odd_even_amplitude_.empty()) {
+    // p <- p - alpha a (method-notes eq. (2.4.19)): the odd-even mode, which neither the nodal
+    // gradient nor the stress points see inside the body, off p^{n+1}; drained nodes stay pinned.
+    const double alpha = m_.setup.fluid.odd_even_filter;
+    const CorrectedOperator<Dim>& oe = odd_even_;
+    exec::particle_for(m_.policy, nn, [&](Index i) {
+      double a = 0.0;
+      const auto r = oe.row(i);
+      for (Index k = r.begin; k < r.end; ++k) a += oe.interp[static_cast<std::size_t>(k)] * pw[oe.source(r, k)];
+      odd_even_amplitude_[static_cast<std::size_t>(i)] = a;
+    });
+    exec::particle_for(m_.policy, nn, [&](Index i) {
+      const auto iu = static_cast<std::size_t>(i);
+      if (!conditions_.drained[iu]) pw[iu] -= alpha * odd_even_amplitude_[iu];
+    });
+  }
   // Velocity correction v^{n+1} = v* - (dt/rho) grad p^{n+1} (same-set corrected gradient).
   exec::particle_for(m_.policy, nn, [&](Index i) {
     double g[Dim];

@@ -69,6 +69,8 @@ class PorePressureStage final : public Stage {
   Field<double, 1> pressure_;
   PorePressureConditions conditions_;
   CorrectedOperator<Dim> node_operator_;  // nodes -> nodes: div v*, grad p
+  CorrectedOperator<Dim> odd_even_;          // its interp slots: the odd-even amplitude (eq. (2.4.19))
+  std::vector<double> odd_even_amplitude_;   // a per node, scratch of the step
   FacePressureCoupling<Dim> face_coupling_;  // implicit face condition (empty: none or explicit)
   std::unique_ptr<PorePressureSolver> solver_;
   std::vector<double> p_old_, source_;

@@ -171,6 +171,13 @@ TEST(InputErrors, UnknownPressureFilterGradient) {
                   {"quadratic_drained", "quadratic", "linear"});
 }
 
+TEST(InputErrors, OddEvenFilterOutOfRange) {
+  test::TempDir dir;
+  const std::string text = replace(kBase, "[time]", "[solver]\npressure_odd_even_filter = 1.5\n[time]");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "pressure_odd_even_filter"), "solver.pressure_odd_even_filter", {"[0, 1]"});
+}
+
 TEST(InputErrors, WrongTypeOfAnArray) {
   test::TempDir dir;
   const std::string text = replace(kBase, "min = [0.0, 0.0]", "min = 0.0");

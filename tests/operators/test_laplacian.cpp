@@ -292,6 +292,46 @@ TEST(PressureFilter, QuadraticGradientFitsOnlyTheSelectedRows) {
   }
 }
 
+// The odd-even amplitude (method-notes eq. (2.4.19)): the pure mode on every determined row,
+// zero on quadratic fields, on a regular and a jittered lattice.
+TEST(OddEvenAmplitude, IsTheModeOnTheModeAndZeroOnQuadratics) {
+  for (double jitter : {0.0, 0.2}) {
+    const double dx = 0.1;
+    const auto s = lattice2(12, 12, dx, jitter);
+    const CubicSplineKernel<2> kernel(1.2 * dx);
+    const auto op = build_corrected_operator<2>(s.position, s, kernel);
+    Index undetermined = -1;
+    const auto oe = odd_even_amplitude<2>(op, s.position, s, kernel, dx, &undetermined);
+    EXPECT_EQ(undetermined, 0) << "jitter " << jitter;
+    auto amplitude = [&](const Eigen::VectorXd& p, Index i) {
+      double a = 0.0;
+      const auto r = oe.row(i);
+      for (Index k = r.begin; k < r.end; ++k) a += oe.interp[static_cast<std::size_t>(k)] * p[oe.source(r, k)];
+      return a;
+    };
+    // The three odd-even modes of a 2D lattice: along x, along y, and the checkerboard.
+    Eigen::VectorXd mode_x(s.size()), mode_y(s.size()), checker(s.size());
+    for (Index i = 0; i < s.size(); ++i) {
+      mode_x[i] = (i % 13) % 2 == 0 ? 1.0 : -1.0;
+      mode_y[i] = (i / 13) % 2 == 0 ? 1.0 : -1.0;
+      checker[i] = mode_x[i] * mode_y[i];
+    }
+    const Eigen::VectorXd q = sample(s, quadratic), lin = sample(s, linear);
+    for (Index i = 0; i < s.size(); ++i) {
+      EXPECT_NEAR(amplitude(checker, i), checker[i], 1e-9) << "row " << i << " jitter " << jitter;
+      // The axis modes on every row that spans three levels beyond itself along both axes (two
+      // rows in from each face); nearer a face the mode normal to it is a parabola there.
+      const Index ix = i % 13, iy = i / 13;
+      if (ix >= 2 && ix <= 10 && iy >= 2 && iy <= 10) {
+        EXPECT_NEAR(amplitude(mode_x, i), mode_x[i], 1e-9) << "row " << i << " jitter " << jitter;
+        EXPECT_NEAR(amplitude(mode_y, i), mode_y[i], 1e-9) << "row " << i << " jitter " << jitter;
+      }
+      EXPECT_NEAR(amplitude(q, i), 0.0, 1e-9) << "row " << i << " jitter " << jitter;
+      EXPECT_NEAR(amplitude(lin, i), 0.0, 1e-9) << "row " << i << " jitter " << jitter;
+    }
+  }
+}
+
 // Where the corrected gradient is already exact for quadratics (a full support on a lattice)
 // its weights are kept bit for bit.
 TEST(PressureFilter, QuadraticGradientKeepsTheInteriorWeights) {
