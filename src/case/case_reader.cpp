@@ -282,7 +282,7 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     else
       s->fail("pressure_filter_gradient",
               fmt::format("unknown value '{}' (known: quadratic_drained, quadratic, linear)", filter_gradient));
-    c.fluid.odd_even_filter = s->number("pressure_odd_even_filter", 0.5);
+    c.fluid.odd_even_filter = s->number("pressure_odd_even_filter", 1.0);
     s->require(c.fluid.odd_even_filter >= 0.0 && c.fluid.odd_even_filter <= 1.0, "pressure_odd_even_filter",
                fmt::format("must lie in [0, 1] (the fraction of the odd-even amplitude removed a step), got {}",
                            c.fluid.odd_even_filter));

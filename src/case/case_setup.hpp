@@ -129,7 +129,7 @@ struct FluidSpec {
   FilterGradient filter_gradient = FilterGradient::quadratic_drained;
   /// solver.pressure_odd_even_filter: the fraction alpha of the local odd-even amplitude taken
   /// off p_w after each solve, p <- p - alpha a (method-notes eq. (2.4.19)); 0 = off.
-  double odd_even_filter = 0.5;
+  double odd_even_filter = 1.0;
   double initial_pore_pressure = 0.0;  // Pa, uniform
   /// 1/Q* = S_w n / K_f + (1 - n)/K_s (method-notes §1.4), 1/Pa
   double inverse_storage() const {
