@@ -44,8 +44,8 @@ void BM_Triad(benchmark::State& state) {
 BENCHMARK(BM_Triad)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // A square 2D elastic block with about `nodes` nodes, fixed base, loaded top (a case built in
-// code, case/case_builder.hpp). `v3`: saturated, drained top, K_f = 0.1 GPa, with the pressure
-// filter coefficient `filter`.
+// code, case/case_builder.hpp). `v3`: saturated, drained top, K_f = 0.1 GPa, with the odd-even
+// filter strength `filter` (solver.pressure_odd_even_filter; 0 = no pressure damping).
 CaseSetup<2> block_case(long nodes, bool v3 = false, double filter = 1.0, double cfl = 0.9,
                         bool implicit_faces = false) {
   const long side = static_cast<long>(std::lround(std::sqrt(static_cast<double>(nodes)))) - 1;

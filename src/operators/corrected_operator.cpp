@@ -577,14 +577,15 @@ CorrectedOperator<Dim> quadratic_exact_gradient(const CorrectedOperator<Dim>& op
 }
 
 template <int Dim>
-CorrectedOperator<Dim> odd_even_amplitude(const CorrectedOperator<Dim>& op, const std::vector<Vec<Dim>>& targets,
-                                          const ParticleSet<Dim>& sources, const CubicSplineKernel<Dim>& kernel,
-                                          double lattice_spacing, Index* undetermined) {
+std::vector<double> odd_even_amplitude(const CorrectedOperator<Dim>& op, const std::vector<Vec<Dim>>& targets,
+                                       const ParticleSet<Dim>& sources, const CubicSplineKernel<Dim>& kernel,
+                                       double lattice_spacing, Index* undetermined) {
   if (!(lattice_spacing > 0.0)) throw SolverError("odd-even amplitude: needs the lattice spacing");
   using Basis = QuadraticBasis<Dim>;
   const Basis basis{kernel.h(), lattice_spacing, true};
-  CorrectedOperator<Dim> out = op;
-  std::fill(out.interp.begin(), out.interp.end(), 0.0);
+  // One weight per pair slot of op: rows that share a pattern share their geometry, hence their
+  // weights, so op's patterns index these as they index op's own.
+  std::vector<double> weight(op.interp.size(), 0.0);
   const Index np = op.patterns();
   std::vector<Index> representative(static_cast<std::size_t>(np), -1);
   for (Index a = 0; a < op.rows(); ++a) {
@@ -612,11 +613,11 @@ CorrectedOperator<Dim> odd_even_amplitude(const CorrectedOperator<Dim>& op, cons
         const auto b = static_cast<std::size_t>(op.source(r, k));
         const double w = sources.volume[b] * kernel.value((sources.position[b] - xa).norm());
         const double c = (Minv * fit(sources.position[b] - xa)).tail(fit.modes()).sum() * w;
-        out.interp[static_cast<std::size_t>(k)] = c;
+        weight[static_cast<std::size_t>(k)] = c;
         total += std::abs(c);
       }
       if (total <= 4.0) return true;
-      for (Index k = r.begin; k < r.end; ++k) out.interp[static_cast<std::size_t>(k)] = 0.0;
+      for (Index k = r.begin; k < r.end; ++k) weight[static_cast<std::size_t>(k)] = 0.0;
       return false;
     };
     if (!try_fit(basis) && !try_fit(Basis{kernel.h(), lattice_spacing, false})) continue;
@@ -628,7 +629,7 @@ CorrectedOperator<Dim> odd_even_amplitude(const CorrectedOperator<Dim>& op, cons
       *undetermined += determined[static_cast<std::size_t>(op.pattern[static_cast<std::size_t>(a)])] == 0 ? 1 : 0;
     }
   }
-  return out;
+  return weight;
 }
 
 #define RKTSPH_INSTANTIATE(D)                                                                                        \
@@ -644,9 +645,8 @@ CorrectedOperator<Dim> odd_even_amplitude(const CorrectedOperator<Dim>& op, cons
   template CorrectedOperator<D> quadratic_exact_gradient<D>(const CorrectedOperator<D>&, const std::vector<Vec<D>>&, \
                                                             const ParticleSet<D>&, const CubicSplineKernel<D>&,      \
                                                             double, const std::vector<char>*, Index*);          \
-  template CorrectedOperator<D> odd_even_amplitude<D>(const CorrectedOperator<D>&, const std::vector<Vec<D>>&,       \
-                                                      const ParticleSet<D>&, const CubicSplineKernel<D>&, double,    \
-                                                      Index*);
+  template std::vector<double> odd_even_amplitude<D>(const CorrectedOperator<D>&, const std::vector<Vec<D>>&,    \
+                                                   const ParticleSet<D>&, const CubicSplineKernel<D>&, double, Index*);
 RKTSPH_INSTANTIATE(1)
 RKTSPH_INSTANTIATE(2)
 RKTSPH_INSTANTIATE(3)

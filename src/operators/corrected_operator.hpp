@@ -146,17 +146,18 @@ CorrectedOperator<Dim> quadratic_exact_gradient(const CorrectedOperator<Dim>& op
                                                 double lattice_spacing, const std::vector<char>* fit_rows = nullptr,
                                                 Index* replaced = nullptr);
 
-/// The local amplitude of the lattice's odd-even modes (method-notes eq. (2.4.19)): in the
-/// result's `interp` slots, the weights of a_a = sum_b w_ab p_b, the sum of the odd-even
+/// The local amplitude of the lattice's odd-even modes (method-notes eq. (2.4.19)): the weights
+/// of a_a = sum_b w_ab p_b, one per pair slot of `op` (row a's pairs are op.row(a), sources
+/// op.source(r, k)), the sum of the odd-even
 /// coefficients of a least-squares fit of the quadratics and the 2^Dim - 1 modes
 /// (-1)^(sum of i_d over a non-empty subset of the axes) over op's sources, so that a = p on each
 /// pure mode and a = 0 on every quadratic field, on every row (faces included). Rows where the fit is
 /// undetermined or the mode barely separable (sum_b |w_ab| > 4) get zero weights; their number
-/// goes to `undetermined`. The gradient weights are op's.
+/// goes to `undetermined`.
 template <int Dim>
-CorrectedOperator<Dim> odd_even_amplitude(const CorrectedOperator<Dim>& op, const std::vector<Vec<Dim>>& targets,
-                                          const ParticleSet<Dim>& sources, const CubicSplineKernel<Dim>& kernel,
-                                          double lattice_spacing, Index* undetermined = nullptr);
+std::vector<double> odd_even_amplitude(const CorrectedOperator<Dim>& op, const std::vector<Vec<Dim>>& targets,
+                                       const ParticleSet<Dim>& sources, const CubicSplineKernel<Dim>& kernel,
+                                       double lattice_spacing, Index* undetermined = nullptr);
 
 /// Difference-form gradients at `targets` over `relation` (built with
 /// difference_gradient_relation_options, one row per target).

@@ -153,7 +153,7 @@ PorePressureStage<Dim>::PorePressureStage(StaggeredModel<Dim>& model) : m_(model
                                    "(geometry.spacing); set it to 0 and use solver.pressure_filter instead",
                                    m_.setup.file));
     }
-    odd_even_ = odd_even_amplitude<Dim>(node_operator_, nodes.position, nodes, m_.kernel, m_.dx());
+    odd_even_weight_ = odd_even_amplitude<Dim>(node_operator_, nodes.position, nodes, m_.kernel, m_.dx());
     odd_even_amplitude_.assign(nn, 0.0);
   }
   if (m_.plates != nullptr && m_.plates->any_force()) {
@@ -320,10 +320,10 @@ void PorePressureStage<Dim>::load(const io::StateArchive& a, const std::string& 
 
 template <int Dim>
 std::size_t PorePressureStage<Dim>::scratch_bytes() const {
-  return (p_old_.size() + source_.size() + pressure_gradient_.size() + skeleton_.size() + odd_even_amplitude_.size()) *
+  return (p_old_.size() + source_.size() + pressure_gradient_.size() + skeleton_.size() + odd_even_weight_.size() +
+          odd_even_amplitude_.size()) *
              sizeof(double) +
-         node_operator_.bytes() + (odd_even_amplitude_.empty() ? 0 : odd_even_.bytes()) +
-         (solver_ != nullptr ? solver_->bytes() : 0) + face_coupling_.bytes();
+         node_operator_.bytes() + (solver_ != nullptr ? solver_->bytes() : 0) + face_coupling_.bytes();
 }
 
 template <int Dim>
@@ -421,11 +421,10 @@ void PorePressureStage<Dim>::run(const StepContext& context) {
     // p <- p - alpha a (method-notes eq. (2.4.19)): the odd-even mode, which neither the nodal
     // gradient nor the stress points see inside the body, off p^{n+1}; drained nodes stay pinned.
     const double alpha = m_.setup.fluid.odd_even_filter;
-    const CorrectedOperator<Dim>& oe = odd_even_;
+    const double* w = odd_even_weight_.data();
     exec::particle_for(m_.policy, nn, [&](Index i) {
       double a = 0.0;
-      const auto r = oe.row(i);
-      for (Index k = r.begin; k < r.end; ++k) a += oe.interp[static_cast<std::size_t>(k)] * pw[oe.source(r, k)];
+      for (Index k = pstart[pat[i]]; k < pstart[pat[i] + 1]; ++k) a += w[k] * pw[base[i] + off[k]];
       odd_even_amplitude_[static_cast<std::size_t>(i)] = a;
     });
     exec::particle_for(m_.policy, nn, [&](Index i) {

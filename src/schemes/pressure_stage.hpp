@@ -55,7 +55,7 @@ class PorePressureStage final : public Stage {
   /// Those faces are taken implicitly (solver.pressure_faces = "implicit"): the limit is gone.
   bool implicit_faces() const { return !face_coupling_.empty(); }
   /// Nodes whose pressure-filter gradient was fitted to quadratics (truncated supports;
-  /// solver.pressure_filter_gradient = "quadratic"), for the log.
+  /// solver.pressure_filter_gradient = "quadratic" or "quadratic_drained"), for summary.json.
   Index filter_fitted_rows() const { return filter_fitted_rows_; }
   static constexpr double kUndrainedCourantLimit = 3.5;
   /// solver.pressure_faces = "auto" takes the faces implicitly above this C c_u/c_d (a margin
@@ -69,8 +69,8 @@ class PorePressureStage final : public Stage {
   Field<double, 1> pressure_;
   PorePressureConditions conditions_;
   CorrectedOperator<Dim> node_operator_;  // nodes -> nodes: div v*, grad p
-  CorrectedOperator<Dim> odd_even_;          // its interp slots: the odd-even amplitude (eq. (2.4.19))
-  std::vector<double> odd_even_amplitude_;   // a per node, scratch of the step
+  std::vector<double> odd_even_weight_;     // per pair slot of node_operator_: eq. (2.4.19)'s a
+  std::vector<double> odd_even_amplitude_;  // a per node, scratch of the step
   FacePressureCoupling<Dim> face_coupling_;  // implicit face condition (empty: none or explicit)
   std::unique_ptr<PorePressureSolver> solver_;
   std::vector<double> p_old_, source_;

@@ -305,8 +305,8 @@ TEST(OddEvenAmplitude, IsTheModeOnTheModeAndZeroOnQuadratics) {
     EXPECT_EQ(undetermined, 0) << "jitter " << jitter;
     auto amplitude = [&](const Eigen::VectorXd& p, Index i) {
       double a = 0.0;
-      const auto r = oe.row(i);
-      for (Index k = r.begin; k < r.end; ++k) a += oe.interp[static_cast<std::size_t>(k)] * p[oe.source(r, k)];
+      const auto r = op.row(i);
+      for (Index k = r.begin; k < r.end; ++k) a += oe[static_cast<std::size_t>(k)] * p[op.source(r, k)];
       return a;
     };
     // The three odd-even modes of a 2D lattice: along x, along y, and the checkerboard.
