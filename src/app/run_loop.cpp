@@ -26,6 +26,7 @@
 #include "io/vtu_writer.hpp"
 #include "rktsph/version.hpp"
 #include "schemes/pressure_stage.hpp"
+#include "schemes/reseed_stage.hpp"
 #include "schemes/simulation.hpp"
 #include "schemes/v2_stages.hpp"
 
@@ -100,7 +101,9 @@ int run_loop(const LoopInput& in) {
   Simulation<Dim> solver(setup);
   const double setup_seconds = std::chrono::duration<double>(Clock::now() - t_setup).count();
   const io::FieldCatalogue<Dim> node_fields(solver, io::FieldCatalogue<Dim>::Set::nodes);
-  const io::FieldCatalogue<Dim> stress_point_fields(solver, io::FieldCatalogue<Dim>::Set::stress_points);
+  // Remade when V2 re-seeds its stress points (the catalogue reads the set's arrays).
+  std::optional<io::FieldCatalogue<Dim>> stress_point_fields;
+  std::int64_t stress_point_fields_made = -1;
   const PorePressureStage<Dim>* pressure = solver.scheme().template find<PorePressureStage<Dim>>();
 
   // Probes: the node nearest the position in the initial configuration; outside the body, an input error.
@@ -240,11 +243,11 @@ int run_loop(const LoopInput& in) {
       if (const auto f = set.template find<double, 1>("free_surface"); f.valid()) {
         for (Index i = 0; i < set.size(); ++i) surface += set.view(f)(i, 0) != 0.0 ? 1 : 0;
       }
-      runout_csv->append(fmt::format("{:.10g},{:.10g},{:.10g},{:.10g},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{},{},{:.15g}\n",
-                                     solver.time(), p.front, p.h.front(), hmax, p.detached, surface, d.min, d.mean,
-                                     d.max, d.cv, d.clustered, d.isolated, mass));
-      std::string profile = fmt::format("# t = {:.10g} s; h above the base y = {:.10g} m\nx,h,count\n", solver.time(),
-                                        runout_base);
+      runout_csv->append(fmt::format(
+          "{:.10g},{:.10g},{:.10g},{:.10g},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{},{},{:.15g}\n", solver.time(), p.front,
+          p.h.front(), hmax, p.detached, surface, d.min, d.mean, d.max, d.cv, d.clustered, d.isolated, mass));
+      std::string profile =
+          fmt::format("# t = {:.10g} s; h above the base y = {:.10g} m\nx,h,count\n", solver.time(), runout_base);
       for (std::size_t k = 0; k < p.h.size(); ++k) {
         profile += fmt::format("{:.10g},{:.10g},{}\n", p.centre(k), p.h[k], p.count[k]);
       }
@@ -296,8 +299,12 @@ int run_loop(const LoopInput& in) {
     node_pvd.add(solver.time(), "vtu/" + name);
     if (setup.output_elements) {
       const std::string ename = fmt::format("elements_{:06d}.vtu", loop.frame);
+      if (stress_point_fields_made != solver.stress_points().replacements()) {
+        stress_point_fields.emplace(solver, io::FieldCatalogue<Dim>::Set::stress_points);
+        stress_point_fields_made = solver.stress_points().replacements();
+      }
       io::write_vtu((out / "vtu" / ename).string(), padded_points<Dim>(solver.stress_points().position),
-                    stress_point_fields.extract());
+                    stress_point_fields->extract());
       elem_pvd.add(solver.time(), "vtu/" + ename);
     }
     ++loop.frame;
@@ -578,8 +585,11 @@ int run_loop(const LoopInput& in) {
           "pore pressure: {} {} solves, iterations mean {:.1f} / max {}, final relative "
           "residual {:.2e}; pressure step {:.0f} % of the loop time\n",
           ps.solves, pressure->implicit_faces() ? "BiCGSTAB" : "PCG", ps.mean_iterations(), ps.max_iterations,
-          ps.last_error,
-          seconds > 0 ? 100.0 * pressure->seconds() / seconds : 0.0);
+          ps.last_error, seconds > 0 ? 100.0 * pressure->seconds() / seconds : 0.0);
+    }
+    if (const auto* reseed = solver.scheme().template find<ReseedStressPoints<Dim>>()) {
+      std::cerr << fmt::format("stress points re-seeded {} times (first at t = {:.4g} s); {} stress points now\n",
+                               reseed->reseeds(), reseed->first_time(), solver.stress_points().size());
     }
     const double node_steps = static_cast<double>(solver.nodes().size()) *
                               static_cast<double>(solver.step_count() - std::max(0L, loop.resumed_from));

@@ -450,4 +450,12 @@ void RigidContact::load(const io::StateArchive& a, const std::string& prefix) {
   selected_ = a.integer(prefix + "selected") != 0;
 }
 
+bool RigidContact::inside(const Vec<2>& x) const {
+  for (std::size_t b = 0; b < bodies_.size(); ++b) {
+    const BodyGap gap = bodies_[b].gap(x, state_[b].offset, depth_);
+    if (gap.within && gap.g < 0.0) return true;
+  }
+  return false;
+}
+
 }  // namespace rktsph

@@ -84,6 +84,9 @@ class RigidContact {
   /// truncation of the support by: x off its surface (beyond the keep distance) but within
   /// `range` of it, and n_out pointing into it (within 45 degrees); -1 if none.
   int faces_body(const Vec<2>& x, const Vec<2>& n_out, double range) const;
+  /// Whether x lies behind the surface of a body where it is now (re-seeding leaves such cells
+  /// empty).
+  bool inside(const Vec<2>& x) const;
 
   void save(io::StateArchive& archive, const std::string& prefix) const;
   void load(const io::StateArchive& archive, const std::string& prefix);

@@ -160,6 +160,12 @@ class CaseBuilder {
     c_.detect_free_surface = detect;
     return *this;
   }
+  /// solver.reseed (V2): when to re-seed the stress points, at most every `interval` steps.
+  CaseBuilder& reseed(ReseedSetting when, long interval = 20) {
+    c_.reseed = when;
+    c_.reseed_interval = interval;
+    return *this;
+  }
   CaseBuilder& fluid(const FluidSpec& f) {
     c_.fluid = f;
     return *this;

@@ -14,8 +14,8 @@
 #include "case/body_reader.hpp"
 #include "case/case_reader.hpp"
 #include "case/case_reader_sections.hpp"
-#include "case/polygon_reader.hpp"
 #include "case/material_reader.hpp"
+#include "case/polygon_reader.hpp"
 #include "case/size_limits.hpp"
 #include "core/error.hpp"
 #include "io/section.hpp"
@@ -114,7 +114,8 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     }
     if (!polygons.empty()) {
       // Polygon bodies (case/polygon_reader.hpp): discretised here, carried as particles with faces.
-      if (c.jitter.fraction > 0.0) g.fail("jitter", "applies to lattices generated from [[geometry.block]], not to polygons");
+      if (c.jitter.fraction > 0.0)
+        g.fail("jitter", "applies to lattices generated from [[geometry.block]], not to polygons");
       read_polygons<Dim>(g, polygons, c);
     }
     if (!particle_files.empty()) {
@@ -313,6 +314,30 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     } else {
       s->fail("free_surface", fmt::format("unknown value '{}' (known: detect, faces)", surface));
     }
+    const std::string reseed = s->string("reseed", "off");
+    if (reseed == "off")
+      c.reseed = ReseedSetting::off;
+    else if (reseed == "auto")
+      c.reseed = ReseedSetting::automatic;
+    else if (reseed == "periodic")
+      c.reseed = ReseedSetting::periodic;
+    else
+      s->fail("reseed", fmt::format("unknown value '{}' (known: off, auto, periodic)", reseed));
+    if (c.reseed != ReseedSetting::off) {
+      s->require(c.version == "v2", "reseed", "re-seeding the stress points needs solver.version = \"v2\"");
+      s->require(c.layout == ParticleLayout::staggered, "reseed", "re-seeding needs solver.scheme = \"staggered\"");
+    }
+    c.reseed_interval = static_cast<long>(s->integer("reseed_interval", 20));
+    s->require(c.reseed_interval >= 1, "reseed_interval",
+               fmt::format("must be at least 1 step, got {}", c.reseed_interval));
+    c.reseed_fill = s->number("reseed_fill", 0.5);
+    s->require(c.reseed_fill > 0.0 && c.reseed_fill <= 1.0, "reseed_fill",
+               fmt::format("must lie in (0, 1] (a fraction of a cell), got {}", c.reseed_fill));
+    c.reseed_distance = s->number("reseed_distance", 1.0);
+    s->require(c.reseed_distance >= 0.5 && c.reseed_distance <= 2.0, "reseed_distance",
+               fmt::format("must lie in [0.5, 2] (a multiple of dx; on the lattice a node's nearest stress point "
+                           "is sqrt(d)/2 dx away), got {}",
+                           c.reseed_distance));
     c.filter_strength = s->number("filter_strength", 0.5);
     s->require(c.filter_strength > 0.0 && c.filter_strength <= 1.0, "filter_strength",
                fmt::format("must lie in (0, 1], got {}", c.filter_strength));
@@ -368,15 +393,17 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
   const bool saturated = find_scheme<Dim>(c.version)->pore_fluid;
   if (!c.polygons.empty()) {
     if (saturated) {
-      g.fail("polygon", "polygon bodies are not available with solver.version = \"v3\" yet (the pore-pressure "
-                        "conditions act on faces normal to an axis only)");
+      g.fail("polygon",
+             "polygon bodies are not available with solver.version = \"v3\" yet (the pore-pressure "
+             "conditions act on faces normal to an axis only)");
     }
     const auto& conditions = c.imported->boundary.condition;
-    const bool inclined = std::any_of(conditions.begin(), conditions.end(),
-                                      [](FaceCondition f) { return f != FaceCondition::axes; });
+    const bool inclined =
+        std::any_of(conditions.begin(), conditions.end(), [](FaceCondition f) { return f != FaceCondition::axes; });
     if (inclined && c.version == "v2" && !c.detect_free_surface) {
-      g.fail("polygon", "a polygon with edges normal to no axis needs solver.free_surface = \"detect\" in V2 "
-                        "(its geometric normals hold in the initial configuration only)");
+      g.fail("polygon",
+             "a polygon with edges normal to no axis needs solver.free_surface = \"detect\" in V2 "
+             "(its geometric normals hold in the initial configuration only)");
     }
   }
   if (auto f = root.optional_table("fluid")) {

@@ -147,6 +147,9 @@ struct ProbeSpec {
   std::vector<std::string> fields;
 };
 
+/// When V2 re-seeds its stress points (solver.reseed).
+enum class ReseedSetting { off, automatic, periodic };
+
 enum class InitialStressKind { zero, geostatic, uniform };
 /// 1D only: the lateral condition of the bar (docs/cases.md §1.1, Case 2).
 enum class BarCondition { uniaxial_strain, uniaxial_stress };
@@ -238,6 +241,15 @@ struct CaseSetup {
   /// (solver.free_surface = "faces" | "detect").
   bool detect_free_surface = false;
   SourceCoupling coupling = SourceCoupling::additive;
+  /// V2: the stress points re-seeded from the node cloud (method-notes §5.2, "Regularisation";
+  /// solver.reseed): never, when the sets drift apart (eq. (5.2.4): more particles than after
+  /// the last re-seeding have no particle of the other set within reseed_distance * dx), or
+  /// every reseed_interval steps; at most once per reseed_interval steps. A cell gets a stress
+  /// point where the nodes fill at least reseed_fill of it (eq. (5.2.1)).
+  ReseedSetting reseed = ReseedSetting::off;
+  long reseed_interval = 20;
+  double reseed_fill = 0.5;
+  double reseed_distance = 1.0;
 
   // output
   double output_interval = 0.0;      // s; 0 = first and last state only

@@ -54,6 +54,33 @@ class ParticleSet {
     for (Column& c : columns_) c.resize(position.size());
   }
 
+  /// Replace every particle by new owned ones (re-seeding, particles/reseed.hpp): the properties
+  /// given (all of one length), every field sized to the new count and zeroed. `replacements`
+  /// sets the count of replacements (a checkpoint's); by default it grows by one.
+  void replace(std::vector<Vec<Dim>> x, std::vector<double> V, std::vector<double> rho, std::vector<int> mat,
+               std::vector<std::int64_t> ids, std::int64_t replacements = -1) {
+    const std::size_t n = x.size();
+    if (V.size() != n || rho.size() != n || mat.size() != n || ids.size() != n) {
+      throw SolverError(fmt::format("{}: replacement properties of unequal lengths", name_));
+    }
+    position = std::move(x);
+    volume = std::move(V);
+    density = std::move(rho);
+    material = std::move(mat);
+    global_id = std::move(ids);
+    owned_ = static_cast<Index>(n);
+    replacements_ = replacements >= 0 ? replacements : replacements_ + 1;
+    for (Column& c : columns_) {
+      c.f64.clear();
+      c.u8.clear();
+      c.i64.clear();
+      c.resize(n);
+    }
+  }
+
+  /// How many times replace() has renewed the set (0 as made from the case).
+  std::int64_t replacements() const { return replacements_; }
+
   /// Register a field (zero-initialised). N = 0 takes the component count from `components`.
   template <class T, int N>
   Field<T, N> add_field(std::string field_name, std::vector<std::string> component_names, unsigned flags,
@@ -225,6 +252,7 @@ class ParticleSet {
 
   std::string name_;
   Index owned_ = 0;
+  std::int64_t replacements_ = 0;
   std::vector<Column> columns_;
 };
 

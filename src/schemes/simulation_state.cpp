@@ -26,6 +26,7 @@ void save_set(const ParticleSet<Dim>& set, std::uint64_t made, io::StateArchive&
   a.put(p + "density", set.density);
   a.put(p + "material", std::vector<std::int64_t>(set.material.begin(), set.material.end()));
   a.put(p + "global_id", set.global_id);
+  a.put_integer(p + "replacements", set.replacements());
   const auto infos = set.fields();
   for (std::size_t id = 0; id < infos.size(); ++id) {
     const FieldInfo& f = infos[id];
@@ -68,6 +69,25 @@ void load_set(ParticleSet<Dim>& set, std::uint64_t made, const io::StateArchive&
   // The particles are made again from the case; as made they must be the checkpoint's, bit for
   // bit (a fingerprint, since in large deformation they have moved since).
   const auto& x = a.doubles(p + "position");
+  if (a.has(p + "replacements") && a.integer(p + "replacements") > 0 &&
+      static_cast<std::uint64_t>(a.integer(p + "made_from_case")) == made) {
+    // The set was renewed during the run (stress points re-seeded, particles/reseed.hpp): made
+    // from the case it is not the checkpoint's; take the checkpoint's particles.
+    const auto& ids = a.integers(p + "global_id");
+    const auto& mats = a.integers(p + "material");
+    const std::size_t n = ids.size();
+    if (x.size() != n * Dim || mats.size() != n || a.doubles(p + "volume").size() != n ||
+        a.doubles(p + "density").size() != n) {
+      throw InputError(
+          fmt::format("the checkpoint's {} are inconsistent (renewed set of {} particles)", set.name(), n));
+    }
+    std::vector<Vec<Dim>> positions(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      for (int d = 0; d < Dim; ++d) positions[i][d] = x[i * Dim + static_cast<std::size_t>(d)];
+    }
+    set.replace(std::move(positions), a.doubles(p + "volume"), a.doubles(p + "density"),
+                std::vector<int>(mats.begin(), mats.end()), ids, a.integer(p + "replacements"));
+  }
   const bool same = x.size() == set.position.size() * Dim && a.integers(p + "global_id") == set.global_id &&
                     static_cast<std::uint64_t>(a.integer(p + "made_from_case")) == made;
   if (!same) {

@@ -208,6 +208,11 @@ StaggeredModel<Dim>::StaggeredModel(CaseSetup<Dim> case_setup, exec::Threads thr
 }
 
 template <int Dim>
+void StaggeredModel<Dim>::stress_points_changed() {
+  stress_point_sources = make_source_runs(stress_points, materials);
+}
+
+template <int Dim>
 void StaggeredModel<Dim>::set_pore_pressure(Field<double, 1> field) {
   fields.pore_pressure = field;
   pore_pressure_ = nodes.view(field).data();

@@ -139,6 +139,10 @@ class StaggeredModel {
   /// power then use the total stress sigma' - p_w 1.
   void set_pore_pressure(Field<double, 1> field);
 
+  /// After the stress points were replaced (re-seeding, particles/reseed.hpp): the per-set
+  /// tables made from them (the source runs); the operators are rebuilt by the V2 stage.
+  void stress_points_changed();
+
   /// Memory of the particle state and of the operators, bytes.
   std::size_t state_bytes() const { return nodes.bytes() + stress_points.bytes(); }
   std::size_t operator_bytes() const;

@@ -114,6 +114,7 @@ void StressPointHalfStep<Dim, PressureTerm, Motion>::run(const StepContext& c) {
   const int stride = sp_k.components();
   const bool sources = sources_->active();
   ViscoplasticSources<Dim>& src = *sources_;
+  if constexpr (Motion::kMoving) src.reserve(sp.size());  // re-seeded stress points (V2)
   const PressureTerm& pressure = pressure_;
   exec::particle_for(
       m_.policy, op.runs(),
@@ -430,6 +431,10 @@ template <int Dim>
 void VelocityFilter<Dim>::run(const StepContext&) {
   const Index ne = m_.stress_points.size();
   const Index nn = m_.nodes.size();
+  // Re-seeded stress points (V2) change their count; otherwise this never allocates.
+  if (at_stress_points_.size() != static_cast<std::size_t>(ne) * Dim) {
+    at_stress_points_.assign(static_cast<std::size_t>(ne) * Dim, 0.0);
+  }
   const double eps = strength_;
   const CorrectedOperator<Dim>& en = m_.to_stress_points;
   const CorrectedOperator<Dim>& ne_op = m_.to_nodes;

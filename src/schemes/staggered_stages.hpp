@@ -37,6 +37,14 @@ class ViscoplasticSources {
   long max_substeps() const { return max_substeps_; }
   void set_max_substeps(long n) { max_substeps_ = n; }
   std::size_t bytes() const { return (sigma_start_.size() + rate_.size()) * sizeof(double); }
+  /// Room for `particles` rows (grows only when a set was re-seeded larger than any before).
+  void reserve(Index particles) {
+    const auto n = static_cast<std::size_t>(particles) * NS;
+    if (active() && sigma_start_.size() < n) {
+      sigma_start_.resize(n, 0.0);
+      rate_.resize(n, 0.0);
+    }
+  }
 
  private:
   StaggeredModel<Dim>& model_;

@@ -12,10 +12,12 @@
 // With rigid bodies (2D, method-notes §4.5): the contact set at t^n after step 0 (its nodes are
 // never flagged as free surface), the contact constraints, projections and reactions after 3.
 #include <chrono>
+#include <functional>
 #include <memory>
 #include <utility>
 
 #include "schemes/registry.hpp"
+#include "schemes/reseed_stage.hpp"
 #include "schemes/staggered_stages.hpp"
 #include "schemes/v2_stages.hpp"
 
@@ -34,6 +36,14 @@ std::unique_ptr<Scheme> make_v2_scheme(StaggeredModel<Dim>& model) {
                                                model.stress_points.position.size(), model.dx(),
                                                [&model](int f, double t) { return model.function_value(f, t); });
     }
+  }
+  if (model.setup.reseed != ReseedSetting::off) {
+    // Before the operators are rebuilt, so that they are built on the new stress points.
+    std::function<bool(const double*)> excluded;
+    if constexpr (Dim == 2) {
+      if (contact) excluded = [contact](const double* x) { return contact->inside(Vec<2>(x[0], x[1])); };
+    }
+    scheme->add(std::make_unique<ReseedStressPoints<Dim>>(model, std::move(excluded)));
   }
   auto& rebuilt = scheme->add(std::move(rebuild));
   if constexpr (Dim == 2) {

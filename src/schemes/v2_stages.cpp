@@ -42,6 +42,7 @@ void RebuildOperators<Dim>::build_relations() {
   }
   nodes_at_build_ = m_.nodes.position;
   stress_points_at_build_ = m_.stress_points.position;
+  stress_point_replacements_at_build_ = m_.stress_points.replacements();
   ++relation_builds_;
   relation_seconds_ += since(t0);
 }
@@ -54,7 +55,8 @@ void RebuildOperators<Dim>::run(const StepContext& c) {
   }
   // Any pair's distance changed by at most the sum of two displacements since the last search.
   double moved = 0.0;
-  if (relation_builds_ > 0) {
+  const bool renewed = m_.stress_points.replacements() != stress_point_replacements_at_build_;
+  if (relation_builds_ > 0 && !renewed) {
     for (std::size_t i = 0; i < nodes_at_build_.size(); ++i) {
       moved = std::max(moved, (m_.nodes.position[i] - nodes_at_build_[i]).squaredNorm());
     }
@@ -62,7 +64,7 @@ void RebuildOperators<Dim>::run(const StepContext& c) {
       moved = std::max(moved, (m_.stress_points.position[i] - stress_points_at_build_[i]).squaredNorm());
     }
   }
-  if (relation_builds_ == 0 || 2.0 * std::sqrt(moved) >= skin_) build_relations();
+  if (relation_builds_ == 0 || renewed || 2.0 * std::sqrt(moved) >= skin_) build_relations();
   const auto t0 = Clock::now();
   rebuild_corrected_operator<Dim>(to_stress_points_, m_.stress_points.position, m_.nodes, m_.kernel,
                                   m_.to_stress_points, m_.policy);

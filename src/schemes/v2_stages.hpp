@@ -64,6 +64,7 @@ class RebuildOperators final : public Stage {
   Relation<Dim> to_stress_points_, to_nodes_, constrained_, node_neighbours_;
   std::vector<Vec<Dim>> constrained_positions_;
   std::vector<Vec<Dim>> nodes_at_build_, stress_points_at_build_;
+  std::int64_t stress_point_replacements_at_build_ = 0;  // a re-seeded set needs a new search
   long relation_builds_ = 0, operator_builds_ = 0;
   double relation_seconds_ = 0.0, operator_seconds_ = 0.0;
   // Rows of the two operators with too few neighbours (plain SPH sums there): the most at any

@@ -156,6 +156,28 @@ TEST(InputErrors, UnknownFreeSurface) {
   expect_error_at(o, line_of(text, "free_surface"), "solver.free_surface", {"detect", "faces"});
 }
 
+TEST(InputErrors, UnknownReseedSetting) {
+  test::TempDir dir;
+  const std::string text = replace(kBase, "[time]", "[solver]\nversion = \"v2\"\nreseed = \"always\"\n[time]");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "reseed"), "solver.reseed", {"off", "auto", "periodic"});
+}
+
+TEST(InputErrors, ReseedingNeedsV2) {
+  test::TempDir dir;
+  const std::string text = replace(kBase, "[time]", "[solver]\nreseed = \"auto\"\n[time]");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "reseed"), "solver.reseed", {"v2"});
+}
+
+TEST(InputErrors, ReseedFillOutOfRange) {
+  test::TempDir dir;
+  const std::string text =
+      replace(kBase, "[time]", "[solver]\nversion = \"v2\"\nreseed = \"auto\"\nreseed_fill = 1.5\n[time]");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "reseed_fill"), "solver.reseed_fill", {"(0, 1]"});
+}
+
 TEST(InputErrors, PressureFilterOutOfRange) {
   test::TempDir dir;
   const std::string text = replace(kBase, "[time]", "[solver]\npressure_filter = -1.0\n[time]");

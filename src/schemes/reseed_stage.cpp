@@ -1,0 +1,105 @@
+#include "schemes/reseed_stage.hpp"
+
+#include <algorithm>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "io/state_archive.hpp"
+
+namespace rktsph {
+
+template <int Dim>
+ReseedStressPoints<Dim>::ReseedStressPoints(StaggeredModel<Dim>& model, std::function<bool(const double*)> excluded)
+    : m_(model) {
+  options_.dx = model.lattice.dx > 0.0 ? model.lattice.dx : model.dx();
+  options_.fill = model.setup.reseed_fill;
+  options_.excluded = std::move(excluded);
+  for (const std::int64_t id : model.stress_points.global_id) next_global_id_ = std::max(next_global_id_, id + 1);
+  for (const std::int64_t id : model.nodes.global_id) next_global_id_ = std::max(next_global_id_, id + 1);
+}
+
+template <int Dim>
+Index ReseedStressPoints<Dim>::uncovered() const {
+  const double limit = m_.setup.reseed_distance * m_.dx();
+  const double limit2 = limit * limit;
+  auto count = [limit2](const CorrectedOperator<Dim>& op, const std::vector<Vec<Dim>>& x,
+                        const std::vector<Vec<Dim>>& y) {
+    Index n = 0;
+    for (Index a = 0; a < op.rows(); ++a) {
+      const auto row = op.row(a);
+      double nearest = std::numeric_limits<double>::infinity();
+      for (Index k = row.begin; k < row.end; ++k) {
+        nearest = std::min(
+            nearest, (x[static_cast<std::size_t>(a)] - y[static_cast<std::size_t>(op.source(row, k))]).squaredNorm());
+      }
+      if (nearest > limit2) ++n;
+    }
+    return n;
+  };
+  // The operators hold the pairs of the last step's search; a particle's moves since are a
+  // fraction of dx, well inside the margin between the limit and the support.
+  return count(m_.to_nodes, m_.nodes.position, m_.stress_points.position) +
+         count(m_.to_stress_points, m_.stress_points.position, m_.nodes.position);
+}
+
+template <int Dim>
+void ReseedStressPoints<Dim>::reseed(double t) {
+  const Vec<Dim> origin = m_.lattice.dx > 0.0 ? m_.lattice.origin : Vec<Dim>::Zero();
+  reseed_stress_points<Dim>(m_.nodes, origin, options_, m_.stress_points, next_global_id_);
+  m_.stress_points_changed();
+  ++reseeds_;
+  if (first_time_ < 0.0) first_time_ = t;
+  last_time_ = t;
+  steps_since_ = 0;
+  baseline_ = -1;
+}
+
+template <int Dim>
+void ReseedStressPoints<Dim>::run(const StepContext& c) {
+  ++steps_since_;
+  // The operators of the first step are not built yet; after a re-seeding the baseline is
+  // measured on the operators rebuilt for the new set.
+  if (m_.to_nodes.rows() != m_.nodes.size() || m_.to_stress_points.rows() != m_.stress_points.size()) return;
+  if (baseline_ < 0) {
+    baseline_ = uncovered();
+    uncovered_ = baseline_;
+  }
+  if (steps_since_ < m_.setup.reseed_interval) return;
+  if (m_.setup.reseed == ReseedSetting::periodic) {
+    reseed(c.t);
+    return;
+  }
+  uncovered_ = uncovered();
+  if (uncovered_ > baseline_) reseed(c.t);
+}
+
+template <int Dim>
+void ReseedStressPoints<Dim>::save(io::StateArchive& a, const std::string& prefix) const {
+  a.put_integer(prefix + "next_global_id", next_global_id_);
+  a.put_integer(prefix + "reseeds", reseeds_);
+  a.put_integer(prefix + "steps_since", steps_since_);
+  a.put_integer(prefix + "baseline", baseline_);
+  a.put_integer(prefix + "uncovered", uncovered_);
+  a.put(prefix + "first_time", first_time_);
+  a.put(prefix + "last_time", last_time_);
+}
+
+template <int Dim>
+void ReseedStressPoints<Dim>::load(const io::StateArchive& a, const std::string& prefix) {
+  next_global_id_ = a.integer(prefix + "next_global_id");
+  reseeds_ = static_cast<long>(a.integer(prefix + "reseeds"));
+  steps_since_ = static_cast<long>(a.integer(prefix + "steps_since"));
+  baseline_ = static_cast<Index>(a.integer(prefix + "baseline"));
+  uncovered_ = static_cast<Index>(a.integer(prefix + "uncovered"));
+  first_time_ = a.number(prefix + "first_time");
+  last_time_ = a.number(prefix + "last_time");
+  // The checkpoint's stress points replaced the case's (schemes/simulation_state.cpp).
+  if (reseeds_ > 0) m_.stress_points_changed();
+}
+
+template class ReseedStressPoints<1>;
+template class ReseedStressPoints<2>;
+template class ReseedStressPoints<3>;
+
+}  // namespace rktsph

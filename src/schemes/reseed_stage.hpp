@@ -1,0 +1,58 @@
+#pragma once
+// V2's first regularisation (method-notes §5.2, "Regularisation"): the stress points re-seeded
+// from the node cloud (particles/reseed.hpp) at the start of a step, before the operators are
+// rebuilt, when the two sets have drifted apart or every solver.reseed_interval steps.
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include "particles/reseed.hpp"
+#include "schemes/stage.hpp"
+#include "schemes/staggered_model.hpp"
+
+namespace rktsph {
+
+template <int Dim>
+class ReseedStressPoints final : public Stage {
+ public:
+  /// `excluded`: cell centres that get no stress point (inside a rigid body); may be empty.
+  ReseedStressPoints(StaggeredModel<Dim>& model, std::function<bool(const double*)> excluded);
+  std::string_view name() const override { return "reseed_stress_points"; }
+  void run(const StepContext& context) override;
+  void save(io::StateArchive& archive, const std::string& prefix) const override;
+  void load(const io::StateArchive& archive, const std::string& prefix) override;
+  std::vector<std::pair<std::string, double>> report() const override {
+    return {{"reseeds", static_cast<double>(reseeds_)},
+            {"reseed_first_time", first_time_},
+            {"reseed_last_time", last_time_},
+            {"stress_points_now", static_cast<double>(m_.stress_points.size())},
+            {"uncovered_particles_last_check", static_cast<double>(uncovered_)}};
+  }
+
+  /// Eq. (5.2.4): the particles of either set whose nearest particle of the other set (within
+  /// the operators' supports) is farther than solver.reseed_distance * dx; a particle with
+  /// none in its support counts too.
+  Index uncovered() const;
+  long reseeds() const { return reseeds_; }
+  /// When the first re-seeding happened, s (-1: none yet).
+  double first_time() const { return first_time_; }
+
+ private:
+  void reseed(double t);
+
+  StaggeredModel<Dim>& m_;
+  ReseedOptions options_;
+  std::int64_t next_global_id_ = 0;
+  long reseeds_ = 0;
+  long steps_since_ = 0;
+  // The uncovered count just after the last re-seeding (particles the lattice cannot cover:
+  // detached nodes): only more than these triggers another (-1: to be measured).
+  Index baseline_ = 0;
+  Index uncovered_ = 0;
+  double first_time_ = -1.0, last_time_ = -1.0;
+};
+
+}  // namespace rktsph
