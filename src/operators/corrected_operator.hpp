@@ -165,6 +165,12 @@ template <int Dim>
 DifferenceGradient<Dim> build_difference_gradient(const Relation<Dim>& relation, const std::vector<Vec<Dim>>& targets,
                                                   const ParticleSet<Dim>& sources,
                                                   const CubicSplineKernel<Dim>& kernel);
+/// The same into `out`, reusing its storage (the V2 step rebuilds it every step without
+/// allocating once its capacity suffices).
+template <int Dim>
+void build_difference_gradient_into(const Relation<Dim>& relation, const std::vector<Vec<Dim>>& targets,
+                                    const ParticleSet<Dim>& sources, const CubicSplineKernel<Dim>& kernel,
+                                    DifferenceGradient<Dim>& out);
 /// The same at the selected targets (one row per entry of `which`), with the relation built here.
 /// The difference gradient at the targets of the rows `which` of `relation` (one sorted row per
 /// target, a wider Verlet list cut back to the support), in the order of `which`.

@@ -58,21 +58,44 @@ void append_difference_row(const Relation<Dim>& relation, Index a, const Vec<Dim
   }
 }
 
+// The pair scratch of the row builders, kept per thread: rebuilt every V2 step, it allocates
+// only until it has grown to the largest row.
+template <int Dim>
+std::vector<Pair<Dim>>& pair_scratch() {
+  thread_local std::vector<Pair<Dim>> pairs;
+  return pairs;
+}
+
+template <int Dim>
+void clear_gradient(DifferenceGradient<Dim>& g) {
+  g.row_start.assign(1, 0);
+  g.source.clear();
+  g.weight.clear();
+  g.weight_sum.clear();
+}
+
 }  // namespace
+
+template <int Dim>
+void build_difference_gradient_into(const Relation<Dim>& relation, const std::vector<Vec<Dim>>& targets,
+                                    const ParticleSet<Dim>& sources, const CubicSplineKernel<Dim>& kernel,
+                                    DifferenceGradient<Dim>& out) {
+  if (relation.rows() != static_cast<Index>(targets.size()) || !relation.options().sorted) {
+    throw SolverError("difference gradient: the relation must have one sorted row per target");
+  }
+  clear_gradient(out);
+  std::vector<Pair<Dim>>& pairs = pair_scratch<Dim>();
+  for (Index a = 0; a < relation.rows(); ++a) {
+    append_difference_row(relation, a, targets[static_cast<std::size_t>(a)], sources, kernel, pairs, out);
+  }
+}
 
 template <int Dim>
 DifferenceGradient<Dim> build_difference_gradient(const Relation<Dim>& relation, const std::vector<Vec<Dim>>& targets,
                                                   const ParticleSet<Dim>& sources,
                                                   const CubicSplineKernel<Dim>& kernel) {
-  if (relation.rows() != static_cast<Index>(targets.size()) || !relation.options().sorted) {
-    throw SolverError("difference gradient: the relation must have one sorted row per target");
-  }
   DifferenceGradient<Dim> g;
-  g.row_start.push_back(0);
-  std::vector<Pair<Dim>> pairs;
-  for (Index a = 0; a < relation.rows(); ++a) {
-    append_difference_row(relation, a, targets[static_cast<std::size_t>(a)], sources, kernel, pairs, g);
-  }
+  build_difference_gradient_into(relation, targets, sources, kernel, g);
   return g;
 }
 
@@ -83,11 +106,8 @@ void build_difference_gradient_rows(const Relation<Dim>& relation, const std::ve
   if (relation.rows() != static_cast<Index>(targets.size()) || !relation.options().sorted) {
     throw SolverError("difference gradient: the relation must have one sorted row per target");
   }
-  out.row_start.assign(1, 0);
-  out.source.clear();
-  out.weight.clear();
-  out.weight_sum.clear();
-  std::vector<Pair<Dim>> pairs;
+  clear_gradient(out);
+  std::vector<Pair<Dim>>& pairs = pair_scratch<Dim>();
   for (const Index a : which) {
     append_difference_row(relation, a, targets[static_cast<std::size_t>(a)], sources, kernel, pairs, out);
   }
@@ -106,6 +126,9 @@ DifferenceGradient<Dim> build_difference_gradient(const std::vector<Vec<Dim>>& t
 
 #define RKTSPH_INSTANTIATE(D)                                                                                        \
   template RelationOptions difference_gradient_relation_options<D>(const CubicSplineKernel<D>&);                     \
+  template void build_difference_gradient_into<D>(const Relation<D>&, const std::vector<Vec<D>>&,                    \
+                                                  const ParticleSet<D>&, const CubicSplineKernel<D>&,                \
+                                                  DifferenceGradient<D>&);                                           \
   template void build_difference_gradient_rows<D>(const Relation<D>&, const std::vector<Vec<D>>&,                    \
                                                   const std::vector<Index>&, const ParticleSet<D>&,                  \
                                                   const CubicSplineKernel<D>&, DifferenceGradient<D>&);              \

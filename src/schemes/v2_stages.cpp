@@ -69,8 +69,8 @@ void RebuildOperators<Dim>::run(const StepContext& c) {
   rebuild_corrected_operator<Dim>(to_stress_points_, m_.stress_points.position, m_.nodes, m_.kernel,
                                   m_.to_stress_points, m_.policy);
   rebuild_corrected_operator<Dim>(to_nodes_, m_.nodes.position, m_.stress_points, m_.kernel, m_.to_nodes, m_.policy);
-  m_.constrained_gradient =
-      build_difference_gradient<Dim>(constrained_, constrained_positions_, m_.stress_points, m_.kernel);
+  build_difference_gradient_into<Dim>(constrained_, constrained_positions_, m_.stress_points, m_.kernel,
+                                      m_.constrained_gradient);
   ++operator_builds_;
   operator_seconds_ += since(t0);
   const Index degenerate = m_.degenerate_operator_rows();

@@ -129,14 +129,22 @@ BarRun run_bar(const std::string& case_file, double dx) {
   // divided by its current length, i.e. the mean axial force through its sections.
   auto slab_force = [&](double a, double b) {
     const auto sig = s.stress_point_stress();
-    double sum = 0.0;
-    for (std::size_t e = 0; e < ne; ++e) {
-      if (XE[e][0] > a && XE[e][0] < b) sum += sps.volume[e] * sig(e, StressComponent::xx);
-    }
     const long ca = std::lround(a / dx), cb = std::lround(b / dx);
-    const double length =
-        mean_x([&](std::size_t i) { return column[i] == cb; }) - mean_x([&](std::size_t i) { return column[i] == ca; });
-    return sum / length;
+    const double xa = mean_x([&](std::size_t i) { return column[i] == ca; });
+    const double xb = mean_x([&](std::size_t i) { return column[i] == cb; });
+    double sum = 0.0;
+    if (sps.replacements() == 0) {
+      for (std::size_t e = 0; e < ne; ++e) {
+        if (XE[e][0] > a && XE[e][0] < b) sum += sps.volume[e] * sig(e, StressComponent::xx);
+      }
+    } else {
+      // Re-seeded stress points (solver.reseed) have no reference position: the slab between
+      // the two node columns where they are now.
+      for (std::size_t e = 0; e < sps.position.size(); ++e) {
+        if (sps.position[e][0] > xa && sps.position[e][0] < xb) sum += sps.volume[e] * sig(e, StressComponent::xx);
+      }
+    }
+    return sum / (xb - xa);
   };
   auto neck = [&](double& width, double& where) {
     std::vector<double> lo(static_cast<std::size_t>(columns), std::numeric_limits<double>::infinity());

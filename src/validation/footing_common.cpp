@@ -32,17 +32,24 @@ FootingRun run_footing(const std::string& case_file, const std::vector<std::stri
   const auto t0 = std::chrono::steady_clock::now();
   const auto& nodes = s.nodes();
   const auto& sps = s.stress_points();
-  const auto nn = static_cast<std::size_t>(nodes.size()), ne = static_cast<std::size_t>(sps.size());
+  const auto nn = static_cast<std::size_t>(nodes.size());
   const std::vector<Vec<2>> X = nodes.position;
-  // The slab: the row of stress points (by reference height) nearest cut_y.
-  double row_y = sps.position[0][1];
-  for (std::size_t e = 0; e < ne; ++e) {
-    if (std::abs(sps.position[e][1] - cut_y) < std::abs(row_y - cut_y)) row_y = sps.position[e][1];
-  }
+  // The slab: the row of stress points (by reference height) nearest cut_y; after a re-seeding
+  // (solver.reseed) the row nearest it where the new stress points are.
   std::vector<std::size_t> slab;
-  for (std::size_t e = 0; e < ne; ++e) {
-    if (std::abs(sps.position[e][1] - row_y) < 0.25 * out.dx) slab.push_back(e);
-  }
+  std::int64_t slab_made = -1;
+  auto select_slab = [&] {
+    const std::size_t n = sps.position.size();
+    double row_y = sps.position[0][1];
+    for (std::size_t e = 0; e < n; ++e) {
+      if (std::abs(sps.position[e][1] - cut_y) < std::abs(row_y - cut_y)) row_y = sps.position[e][1];
+    }
+    slab.clear();
+    for (std::size_t e = 0; e < n; ++e) {
+      if (std::abs(sps.position[e][1] - row_y) < 0.25 * out.dx) slab.push_back(e);
+    }
+    slab_made = sps.replacements();
+  };
   const HistoryView eps = node_history(s, "eps_vp_eq", "footing validation");
   auto record = [&] {
     const BodyState& b = enforce->contact().state()[0];
@@ -53,6 +60,7 @@ FootingRun run_footing(const std::string& case_file, const std::vector<std::stri
     r.shear = b.force[0];
     r.width = b.width;
     r.pressure = b.force[1] / loaded_width;
+    if (slab_made != sps.replacements()) select_slab();
     const auto sig = s.stress_point_stress();
     double sum = 0.0;
     for (const std::size_t e : slab) sum += sig(e, StressComponent::yy) * sps.volume[e];
@@ -81,7 +89,7 @@ FootingRun run_footing(const std::string& case_file, const std::vector<std::stri
       m.eps.push_back(eps(i));
     }
     const auto sig = s.stress_point_stress();
-    for (std::size_t e = 0; e < ne; ++e) {
+    for (std::size_t e = 0; e < sps.position.size(); ++e) {
       m.sx.push_back(sps.position[e][0]);
       m.sy.push_back(sps.position[e][1]);
       m.flowing.push_back(sig.invariants(e).q > yield_stress ? 1 : 0);
