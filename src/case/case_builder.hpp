@@ -166,6 +166,12 @@ class CaseBuilder {
     c_.reseed_interval = interval;
     return *this;
   }
+  /// solver.shift (V2): when to shift the nodes, at most every `interval` steps.
+  CaseBuilder& shift(ShiftSetting when, long interval = 20) {
+    c_.shift = when;
+    c_.shift_interval = interval;
+    return *this;
+  }
   CaseBuilder& fluid(const FluidSpec& f) {
     c_.fluid = f;
     return *this;

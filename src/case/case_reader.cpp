@@ -338,6 +338,32 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
                fmt::format("must lie in [0.5, 2] (a multiple of dx; on the lattice a node's nearest stress point "
                            "is sqrt(d)/2 dx away), got {}",
                            c.reseed_distance));
+    c.reseed_cover = s->number("reseed_cover", 0.45);
+    s->require(c.reseed_cover >= 0.0 && c.reseed_cover < 0.5, "reseed_cover",
+               fmt::format("must lie in [0, 0.5) (a fraction of dx from a cell's centre), got {}", c.reseed_cover));
+    const std::string shift = s->string("shift", "off");
+    if (shift == "off")
+      c.shift = ShiftSetting::off;
+    else if (shift == "auto")
+      c.shift = ShiftSetting::automatic;
+    else if (shift == "periodic")
+      c.shift = ShiftSetting::periodic;
+    else
+      s->fail("shift", fmt::format("unknown value '{}' (known: off, auto, periodic)", shift));
+    if (c.shift != ShiftSetting::off) {
+      s->require(c.version == "v2" && c.detect_free_surface, "shift",
+                 "shifting the nodes needs solver.version = \"v2\" with free_surface = \"detect\" (2D, 3D): "
+                 "the surface keeps its place");
+    }
+    c.shift_interval = static_cast<long>(s->integer("shift_interval", 20));
+    s->require(c.shift_interval >= 1, "shift_interval",
+               fmt::format("must be at least 1 step, got {}", c.shift_interval));
+    c.shift_strength = s->number("shift_strength", 0.01);
+    s->require(c.shift_strength > 0.0 && c.shift_strength <= 0.1, "shift_strength",
+               fmt::format("must lie in (0, 0.1] (beta of method-notes eq. 5.2.6), got {}", c.shift_strength));
+    c.shift_distance = s->number("shift_distance", 0.5);
+    s->require(c.shift_distance > 0.0 && c.shift_distance <= 1.0, "shift_distance",
+               fmt::format("must lie in (0, 1] (a multiple of dx), got {}", c.shift_distance));
     c.filter_strength = s->number("filter_strength", 0.5);
     s->require(c.filter_strength > 0.0 && c.filter_strength <= 1.0, "filter_strength",
                fmt::format("must lie in (0, 1], got {}", c.filter_strength));

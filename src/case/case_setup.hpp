@@ -149,6 +149,8 @@ struct ProbeSpec {
 
 /// When V2 re-seeds its stress points (solver.reseed).
 enum class ReseedSetting { off, automatic, periodic };
+/// When V2 shifts its nodes (solver.shift).
+enum class ShiftSetting { off, automatic, periodic };
 
 enum class InitialStressKind { zero, geostatic, uniform };
 /// 1D only: the lateral condition of the bar (docs/cases.md §1.1, Case 2).
@@ -250,6 +252,15 @@ struct CaseSetup {
   long reseed_interval = 20;
   double reseed_fill = 0.5;
   double reseed_distance = 1.0;
+  double reseed_cover = 0.45;  // solver.reseed_cover: less-filled cells with a node near the centre
+  /// V2 in 2D/3D: the nodes shifted down their concentration gradient (method-notes §5.2,
+  /// "Regularisation", eqs. (5.2.5)-(5.2.7); solver.shift): never, when two nodes come closer
+  /// than shift_distance * dx (checked every shift_interval steps), or every shift_interval
+  /// steps; shift_strength is beta of eq. (5.2.6).
+  ShiftSetting shift = ShiftSetting::off;
+  long shift_interval = 20;
+  double shift_strength = 0.01;
+  double shift_distance = 0.5;
 
   // output
   double output_interval = 0.0;      // s; 0 = first and last state only

@@ -46,6 +46,7 @@ struct Deposit {
   std::int64_t cell;
   int material;
   double volume, mass;
+  bool covers = false;  // a node lies within options.cover * dx of the cell's centre
 };
 
 }  // namespace
@@ -85,6 +86,18 @@ ReseedResult reseed_stress_points(const ParticleSet<Dim>& nodes, const Vec<Dim>&
       }
       if (w <= 0.0) continue;
       deposits.push_back({pack<Dim>(c), nodes.material[iu], w * nodes.volume[iu], w * nodes.mass(i)});
+    }
+    if (options.cover > 0.0) {
+      // The cell whose centre the node is nearest, if within the cover window (per axis).
+      std::array<std::int64_t, Dim> c{};
+      bool inside = true;
+      for (int d = 0; d < Dim; ++d) {
+        const double s = (nodes.position[iu][d] - origin[d]) / options.dx;
+        const double cell = std::floor(s);
+        c[static_cast<std::size_t>(d)] = static_cast<std::int64_t>(cell);
+        inside = inside && std::abs(s - cell - 0.5) < options.cover;
+      }
+      if (inside) deposits.push_back({pack<Dim>(c), nodes.material[iu], 0.0, 0.0, true});
     }
   }
   // The old stress points by cell: a new cell takes the material of the nearest old stress
@@ -131,7 +144,8 @@ ReseedResult reseed_stress_points(const ParticleSet<Dim>& nodes, const Vec<Dim>&
     if (a.cell != b.cell) return a.cell < b.cell;
     if (a.material != b.material) return a.material < b.material;
     if (a.volume != b.volume) return a.volume < b.volume;
-    return a.mass < b.mass;
+    if (a.mass != b.mass) return a.mass < b.mass;
+    return a.covers < b.covers;
   });
 
   const double cell_volume = std::pow(options.dx, Dim);
@@ -142,12 +156,14 @@ ReseedResult reseed_stress_points(const ParticleSet<Dim>& nodes, const Vec<Dim>&
     const std::int64_t cell = deposits[k].cell;
     double volume = 0.0, mass = 0.0, best_volume = -1.0;
     int best_material = -1;
+    bool covered = false;
     while (k < deposits.size() && deposits[k].cell == cell) {
       const int m = deposits[k].material;
       double volume_m = 0.0;
       for (; k < deposits.size() && deposits[k].cell == cell && deposits[k].material == m; ++k) {
         volume_m += deposits[k].volume;
         mass += deposits[k].mass;
+        covered = covered || deposits[k].covers;
       }
       volume += volume_m;
       if (volume_m > best_volume) {  // ties go to the lower material index
@@ -156,7 +172,7 @@ ReseedResult reseed_stress_points(const ParticleSet<Dim>& nodes, const Vec<Dim>&
       }
     }
     // The cell's fill (its deposited volume over its own) decides whether it holds a stress point.
-    if (volume < options.fill * cell_volume) continue;
+    if (volume < options.fill * cell_volume && !(covered && volume > 0.0)) continue;
     const auto c = unpack<Dim>(cell);
     Vec<Dim> centre;
     for (int d = 0; d < Dim; ++d) {

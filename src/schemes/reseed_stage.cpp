@@ -14,6 +14,7 @@ ReseedStressPoints<Dim>::ReseedStressPoints(StaggeredModel<Dim>& model, std::fun
     : m_(model) {
   options_.dx = model.lattice.dx > 0.0 ? model.lattice.dx : model.dx();
   options_.fill = model.setup.reseed_fill;
+  options_.cover = model.setup.reseed_cover;
   options_.excluded = std::move(excluded);
   for (const std::int64_t id : model.stress_points.global_id) next_global_id_ = std::max(next_global_id_, id + 1);
   for (const std::int64_t id : model.nodes.global_id) next_global_id_ = std::max(next_global_id_, id + 1);
@@ -58,20 +59,28 @@ void ReseedStressPoints<Dim>::reseed(double t) {
 template <int Dim>
 void ReseedStressPoints<Dim>::run(const StepContext& c) {
   ++steps_since_;
-  // The operators of the first step are not built yet; after a re-seeding the baseline is
-  // measured on the operators rebuilt for the new set.
-  if (m_.to_nodes.rows() != m_.nodes.size() || m_.to_stress_points.rows() != m_.stress_points.size()) return;
+  if (m_.setup.reseed == ReseedSetting::periodic) {
+    if (steps_since_ >= m_.setup.reseed_interval) reseed(c.t);
+    return;
+  }
+  if (pending_) {
+    pending_ = false;
+    reseed(c.t);
+  }
+}
+
+template <int Dim>
+void ReseedStressPoints<Dim>::check() {
+  if (m_.setup.reseed != ReseedSetting::automatic) return;
+  // Just after a re-seeding: the count the lattice cannot help (detached nodes).
   if (baseline_ < 0) {
     baseline_ = uncovered();
     uncovered_ = baseline_;
-  }
-  if (steps_since_ < m_.setup.reseed_interval) return;
-  if (m_.setup.reseed == ReseedSetting::periodic) {
-    reseed(c.t);
     return;
   }
+  if (steps_since_ + 1 < m_.setup.reseed_interval) return;
   uncovered_ = uncovered();
-  if (uncovered_ > baseline_) reseed(c.t);
+  pending_ = uncovered_ > baseline_;
 }
 
 template <int Dim>
@@ -81,6 +90,7 @@ void ReseedStressPoints<Dim>::save(io::StateArchive& a, const std::string& prefi
   a.put_integer(prefix + "steps_since", steps_since_);
   a.put_integer(prefix + "baseline", baseline_);
   a.put_integer(prefix + "uncovered", uncovered_);
+  a.put_integer(prefix + "pending", pending_ ? 1 : 0);
   a.put(prefix + "first_time", first_time_);
   a.put(prefix + "last_time", last_time_);
 }
@@ -92,6 +102,7 @@ void ReseedStressPoints<Dim>::load(const io::StateArchive& a, const std::string&
   steps_since_ = static_cast<long>(a.integer(prefix + "steps_since"));
   baseline_ = static_cast<Index>(a.integer(prefix + "baseline"));
   uncovered_ = static_cast<Index>(a.integer(prefix + "uncovered"));
+  pending_ = a.integer(prefix + "pending") != 0;
   first_time_ = a.number(prefix + "first_time");
   last_time_ = a.number(prefix + "last_time");
   // The checkpoint's stress points replaced the case's (schemes/simulation_state.cpp).

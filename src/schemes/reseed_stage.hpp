@@ -36,6 +36,10 @@ class ReseedStressPoints final : public Stage {
   /// the operators' supports) is farther than solver.reseed_distance * dx; a particle with
   /// none in its support counts too.
   Index uncovered() const;
+  /// At the end of a step (stage ReseedCheck), on the operators of the step and the positions
+  /// at its end, as the next step starts: whether that step re-seeds ("auto"). The decision is
+  /// kept in checkpoints, so that a resumed run decides as the uninterrupted one.
+  void check();
   long reseeds() const { return reseeds_; }
   /// When the first re-seeding happened, s (-1: none yet).
   double first_time() const { return first_time_; }
@@ -52,7 +56,20 @@ class ReseedStressPoints final : public Stage {
   // detached nodes): only more than these triggers another (-1: to be measured).
   Index baseline_ = 0;
   Index uncovered_ = 0;
+  bool pending_ = false;  // the next step re-seeds
   double first_time_ = -1.0, last_time_ = -1.0;
+};
+
+/// The end-of-step half of ReseedStressPoints ("auto"): see ReseedStressPoints::check().
+template <int Dim>
+class ReseedCheck final : public Stage {
+ public:
+  explicit ReseedCheck(ReseedStressPoints<Dim>& reseed) : reseed_(reseed) {}
+  std::string_view name() const override { return "reseed_check"; }
+  void run(const StepContext&) override { reseed_.check(); }
+
+ private:
+  ReseedStressPoints<Dim>& reseed_;
 };
 
 }  // namespace rktsph

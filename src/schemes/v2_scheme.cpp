@@ -18,6 +18,7 @@
 
 #include "schemes/registry.hpp"
 #include "schemes/reseed_stage.hpp"
+#include "schemes/shift_stage.hpp"
 #include "schemes/staggered_stages.hpp"
 #include "schemes/v2_stages.hpp"
 
@@ -37,20 +38,28 @@ std::unique_ptr<Scheme> make_v2_scheme(StaggeredModel<Dim>& model) {
                                                [&model](int f, double t) { return model.function_value(f, t); });
     }
   }
+  ReseedStressPoints<Dim>* reseed = nullptr;
   if (model.setup.reseed != ReseedSetting::off) {
     // Before the operators are rebuilt, so that they are built on the new stress points.
     std::function<bool(const double*)> excluded;
     if constexpr (Dim == 2) {
       if (contact) excluded = [contact](const double* x) { return contact->inside(Vec<2>(x[0], x[1])); };
     }
-    scheme->add(std::make_unique<ReseedStressPoints<Dim>>(model, std::move(excluded)));
+    reseed = &scheme->add(std::make_unique<ReseedStressPoints<Dim>>(model, std::move(excluded)));
   }
   auto& rebuilt = scheme->add(std::move(rebuild));
   if constexpr (Dim == 2) {
     if (contact) scheme->add(std::make_unique<ContactSelect>(model, rebuilt, contact));
   }
   if (model.setup.detect_free_surface) {
-    surface = &scheme->add(std::make_unique<DetectFreeSurface<Dim>>(model, rebuilt));
+    auto detect = std::make_unique<DetectFreeSurface<Dim>>(model, rebuilt);
+    if constexpr (Dim >= 2) {
+      if (model.setup.shift != ShiftSetting::off) {
+        // After the contact set (its nodes stay), before the detection on the shifted nodes.
+        scheme->add(std::make_unique<ShiftNodes<Dim>>(model, rebuilt, contact.get(), &detect->corners()));
+      }
+    }
+    surface = &scheme->add(std::move(detect));
     if constexpr (Dim == 2) surface->set_contact(contact.get());
   }
   scheme->add(std::make_unique<StressPointHalfStep<Dim, NoPressureGradient, MovingParticles>>(model, sources));
@@ -79,6 +88,7 @@ std::unique_ptr<Scheme> make_v2_scheme(StaggeredModel<Dim>& model) {
     }
   }
   if (surface != nullptr) scheme->add(std::make_unique<SurfaceTractionFree<Dim>>(*surface));
+  if (reseed != nullptr) scheme->add(std::make_unique<ReseedCheck<Dim>>(*reseed));
   return scheme;
 }
 

@@ -179,11 +179,13 @@ void DetectFreeSurface<Dim>::run(const StepContext&) {
 template <int Dim>
 void DetectFreeSurface<Dim>::save(io::StateArchive& a, const std::string& prefix) const {
   a.put_integer(prefix + "detections", detections_);
+  a.put(prefix + "corners", corners_);  // node shifting reads them before the next detection
 }
 
 template <int Dim>
 void DetectFreeSurface<Dim>::load(const io::StateArchive& a, const std::string& prefix) {
   detections_ = a.integer(prefix + "detections");
+  if (a.has(prefix + "corners")) corners_ = a.bytes(prefix + "corners");
 }
 
 template <int Dim>

@@ -98,6 +98,8 @@ class DetectFreeSurface final : public Stage {
   /// Rigid bodies (2D): their contact nodes are never flagged, and a node whose flag only
   /// reflects the support cut by a body (its normal pointing into the body) is unflagged.
   void set_contact(const RigidContact* contact) { contact_ = contact; }
+  /// 1 at the flagged nodes where two faces meet, from the last detection (empty before it).
+  const std::vector<std::uint8_t>& corners() const { return corners_; }
   std::vector<std::pair<std::string, double>> report() const override {
     return {{"surface_nodes_last_step", static_cast<double>(surface_nodes_)},
             {"detection_seconds", seconds_},

@@ -243,13 +243,23 @@ TEST(Resume, V3InterruptedBySigintResumesBitForBit) { interrupt_and_resume(kV3, 
 // checkpoint, and rebuilds its Verlet lists on resume.
 TEST(Resume, V2InterruptedBySigtermResumesBitForBit) { interrupt_and_resume(kV2, SIGTERM, 2, 13); }
 
-// With the stress points re-seeded every 7 steps the checkpoint holds a set that the case does
-// not make: it is restored from the checkpoint (ids, materials, volumes, densities).
+// With the stress points re-seeded ("auto", checked every 7 steps, a tight trigger so that it
+// fires) the checkpoint holds a set that the case does not make: it is restored from the
+// checkpoint (ids, materials, volumes, densities), and the pending decision with it.
 TEST(Resume, V2WithReseededStressPointsResumesBitForBit) {
   std::string text = kV2;
   const std::string key = "version = \"v2\"";
-  text.replace(text.find(key), key.size(), key + "\nreseed = \"periodic\"\nreseed_interval = 7");
+  text.replace(text.find(key), key.size(), key + "\nreseed = \"auto\"\nreseed_interval = 7\nreseed_distance = 0.75");
   interrupt_and_resume(text.c_str(), SIGTERM, 1, 14);
+}
+
+// Node shifting every 5 steps (its counters in the checkpoint; the shifted positions are the
+// nodes' state).
+TEST(Resume, V2WithShiftedNodesResumesBitForBit) {
+  std::string text = kV2;
+  const std::string key = "version = \"v2\"";
+  text.replace(text.find(key), key.size(), key + "\nshift = \"periodic\"\nshift_interval = 5");
+  interrupt_and_resume(text.c_str(), SIGTERM, 2, 15);
 }
 
 // A complete frame: the closing tag of a VTK file at its end.

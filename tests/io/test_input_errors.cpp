@@ -178,6 +178,22 @@ TEST(InputErrors, ReseedFillOutOfRange) {
   expect_error_at(o, line_of(text, "reseed_fill"), "solver.reseed_fill", {"(0, 1]"});
 }
 
+TEST(InputErrors, ShiftingNeedsV2WithTheDetectedSurface) {
+  test::TempDir dir;
+  const std::string text =
+      replace(kBase, "[time]", "[solver]\nversion = \"v2\"\nfree_surface = \"faces\"\nshift = \"auto\"\n[time]");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "shift"), "solver.shift", {"detect"});
+}
+
+TEST(InputErrors, ShiftStrengthOutOfRange) {
+  test::TempDir dir;
+  const std::string text =
+      replace(kBase, "[time]", "[solver]\nversion = \"v2\"\nshift = \"periodic\"\nshift_strength = 0.5\n[time]");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "shift_strength"), "solver.shift_strength", {"(0, 0.1]"});
+}
+
 TEST(InputErrors, PressureFilterOutOfRange) {
   test::TempDir dir;
   const std::string text = replace(kBase, "[time]", "[solver]\npressure_filter = -1.0\n[time]");

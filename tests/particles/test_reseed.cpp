@@ -163,6 +163,37 @@ TEST(Reseed, DoesNotDependOnTheNodesOrderAndLeavesExcludedCellsEmpty) {
   EXPECT_NEAR(total_mass(c) / total_mass(lat.stress_points), 1.0, 1e-13);
 }
 
+// A film thinner than half a cell (a run-out front): its cells are filled 0.3 and get no stress
+// point by the fill alone; with the cover window they do, where a node lies near the centre.
+// On the undeformed lattice the window changes nothing (no node lies within 1/2 dx of a centre).
+TEST(Reseed, TheCoverWindowSeedsAThinFilmAndLeavesTheLatticeAlone) {
+  const double dx = 0.25;
+  ParticleSet<2> film("nodes");
+  for (int k = 0; k < 12; ++k) film.add(Vec<2>((k + 0.5) * dx, 0.5 * dx), 0.3 * dx * dx, 2000.0, 0);
+  ParticleSet<2> sp("stress_points");
+  sp.add(Vec<2>(0.5 * dx, 0.5 * dx), dx * dx, 2000.0, 0);
+  std::int64_t next = 0;
+  EXPECT_THROW(reseed_stress_points<2>(film, Vec<2>(0.0, 0.0), spacing(dx), sp, next), SolverError);  // none filled
+  ReseedOptions covered = spacing(dx);
+  covered.cover = 0.25;
+  const ReseedResult r = reseed_stress_points<2>(film, Vec<2>(0.0, 0.0), covered, sp, next);
+  EXPECT_EQ(r.after, 12);
+  for (Index e = 0; e < sp.size(); ++e) {
+    const auto eu = static_cast<std::size_t>(e);
+    EXPECT_NEAR((sp.position[eu] - film.position[eu]).norm(), 0.0, 1e-15);
+    EXPECT_NEAR(sp.density[eu], 2000.0, 1e-9);
+  }
+  const LatticeParticles<2> lat = l_shape(dx);
+  ParticleSet<2> a = lat.stress_points, b = lat.stress_points;
+  std::int64_t na = 0, nb = 0;
+  reseed_stress_points<2>(lat.nodes, lat.lattice.origin, spacing(dx), a, na);
+  ReseedOptions wide = spacing(dx);
+  wide.cover = 0.49;
+  reseed_stress_points<2>(lat.nodes, lat.lattice.origin, wide, b, nb);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t e = 0; e < a.position.size(); ++e) EXPECT_EQ(a.position[e], b.position[e]);
+}
+
 TEST(Reseed, RefusesANonPositiveSpacing) {
   const LatticeParticles<2> lat = l_shape(0.5);
   ParticleSet<2> sp = lat.stress_points;
