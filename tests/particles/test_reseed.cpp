@@ -194,6 +194,35 @@ TEST(Reseed, TheCoverWindowSeedsAThinFilmAndLeavesTheLatticeAlone) {
   for (std::size_t e = 0; e < a.position.size(); ++e) EXPECT_EQ(a.position[e], b.position[e]);
 }
 
+// 3D: a box of 4 x 3 x 2 cells. Its 8 corner cells are filled 27/64 < 1/2 (no fill separates
+// them from a cell at a re-entrant edge, 7/16): they are dropped, every other cell is kept,
+// and the mass stays with the others.
+TEST(Reseed, InThreeDimensionsDropsOnlyTheBoxCorners) {
+  Block<3> b;
+  b.min = Vec<3>(0.0, 0.0, 0.0);
+  b.max = Vec<3>(1.0, 0.75, 0.5);
+  b.label = "box";
+  const double dx = 0.25;
+  const LatticeParticles<3> lat = generate_lattice<3>({b}, dx, Vec<3>(0.0, 0.0, 0.0), {1800.0});
+  ParticleSet<3> sp = lat.stress_points;
+  double m0 = 0.0;
+  for (Index e = 0; e < sp.size(); ++e) m0 += sp.mass(e);
+  std::int64_t next = 0;
+  ReseedOptions o;
+  o.dx = dx;
+  const ReseedResult r = reseed_stress_points<3>(lat.nodes, lat.lattice.origin, o, sp, next);
+  EXPECT_EQ(r.before, 24);
+  EXPECT_EQ(r.after, 16);
+  double m = 0.0;
+  for (Index e = 0; e < sp.size(); ++e) m += sp.mass(e);
+  EXPECT_NEAR(m / m0, 1.0, 1e-14);
+  for (const auto& x : sp.position) {
+    const bool corner =
+        (x[0] < dx || x[0] > 1.0 - dx) && (x[1] < dx || x[1] > 0.75 - dx) && (x[2] < dx || x[2] > 0.5 - dx);
+    EXPECT_FALSE(corner) << x.transpose();
+  }
+}
+
 TEST(Reseed, RefusesANonPositiveSpacing) {
   const LatticeParticles<2> lat = l_shape(0.5);
   ParticleSet<2> sp = lat.stress_points;
