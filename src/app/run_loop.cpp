@@ -27,6 +27,7 @@
 #include "rktsph/version.hpp"
 #include "schemes/pressure_stage.hpp"
 #include "schemes/reseed_stage.hpp"
+#include "schemes/shift_stage.hpp"
 #include "schemes/simulation.hpp"
 #include "schemes/v2_stages.hpp"
 
@@ -254,9 +255,39 @@ int run_loop(const LoopInput& in) {
       io::write_file_atomically((out / "deposit.csv").string(), profile, false);
     }
   };
+  // particles.csv (V2 in 2D, docs/output.md): the particle disorder of the nodes, the mass and
+  // the regularisations (issue 12 item 5) at every output step, with or without bodies.
+  std::optional<io::RowFile> particles_csv;
+  const ReseedStressPoints<Dim>* reseed_stage = solver.scheme().template find<ReseedStressPoints<Dim>>();
+  const ShiftNodes<Dim>* shift_stage = nullptr;
+  if constexpr (Dim >= 2) shift_stage = solver.scheme().template find<ShiftNodes<Dim>>();
+  if (Dim == 2 && setup.version == "v2") {
+    const bool kept = resuming && in.checkpoint->has("run/particles_bytes");
+    particles_csv.emplace((out / "particles.csv").string(), kept ? in.checkpoint->integer("run/particles_bytes") : -1);
+    if (!kept) {
+      particles_csv->append(
+          "t,nn_min,nn_mean,nn_max,nn_cv,clustered,isolated,surface_nodes,mass,stress_points,reseeds,shifts\n");
+    }
+  }
+  auto record_particles = [&] {
+    if constexpr (Dim == 2) {
+      if (!particles_csv) return;
+      const auto& set = solver.nodes();
+      const io::Disorder d = io::particle_disorder(set.position, setup.dx);
+      long surface = 0;
+      if (const auto f = set.template find<double, 1>("free_surface"); f.valid()) {
+        for (Index i = 0; i < set.size(); ++i) surface += set.view(f)(i, 0) != 0.0 ? 1 : 0;
+      }
+      particles_csv->append(fmt::format(
+          "{:.10g},{:.6g},{:.6g},{:.6g},{:.6g},{},{},{},{:.15g},{},{},{}\n", solver.time(), d.min, d.mean, d.max, d.cv,
+          d.clustered, d.isolated, surface, solver.total_mass(), solver.stress_points().size(),
+          reseed_stage != nullptr ? reseed_stage->reseeds() : 0L, shift_stage != nullptr ? shift_stage->shifts() : 0L));
+    }
+  };
   auto record_bodies = [&] {
     if (bodies_csv) bodies_csv->append(bodies->csv_rows(solver.time()));
     record_runout();
+    record_particles();
   };
   io::PvdCollection node_pvd((out / "nodes.pvd").string());
   io::PvdCollection elem_pvd((out / "elements.pvd").string());
@@ -314,6 +345,7 @@ int run_loop(const LoopInput& in) {
     energy_csv.flush();
     if (bodies_csv) bodies_csv->flush();
     if (runout_csv) runout_csv->flush();
+    if (particles_csv) particles_csv->flush();
   };
   const fs::path checkpoint_file = out / "checkpoint" / "checkpoint.h5";
   auto write_checkpoint = [&](double loop_seconds) {
@@ -339,6 +371,7 @@ int run_loop(const LoopInput& in) {
     a.put_integer("run/energy_bytes", energy_csv.written());
     if (bodies_csv) a.put_integer("run/bodies_bytes", bodies_csv->written());
     if (runout_csv) a.put_integer("run/runout_bytes", runout_csv->written());
+    if (particles_csv) a.put_integer("run/particles_bytes", particles_csv->written());
     save_entries(a, "run/node_frames", node_pvd.entries());
     save_entries(a, "run/stress_point_frames", elem_pvd.entries());
     fs::create_directories(out / "checkpoint");

@@ -1,6 +1,7 @@
 #include "schemes/reseed_stage.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <limits>
 
 #include <fmt/format.h>
@@ -24,22 +25,23 @@ template <int Dim>
 Index ReseedStressPoints<Dim>::uncovered() const {
   const double limit = m_.setup.reseed_distance * m_.dx();
   const double limit2 = limit * limit;
-  auto count = [limit2](const CorrectedOperator<Dim>& op, const std::vector<Vec<Dim>>& x,
-                        const std::vector<Vec<Dim>>& y) {
-    Index n = 0;
-    for (Index a = 0; a < op.rows(); ++a) {
+  auto count = [this, limit2](const CorrectedOperator<Dim>& op, const std::vector<Vec<Dim>>& x,
+                              const std::vector<Vec<Dim>>& y) {
+    // An integer sum: the same whatever the threads' order.
+    std::atomic<Index> n{0};
+    exec::particle_for(m_.policy, op.rows(), [&](Index a) {
       const auto row = op.row(a);
       double nearest = std::numeric_limits<double>::infinity();
       for (Index k = row.begin; k < row.end; ++k) {
         nearest = std::min(
             nearest, (x[static_cast<std::size_t>(a)] - y[static_cast<std::size_t>(op.source(row, k))]).squaredNorm());
       }
-      if (nearest > limit2) ++n;
-    }
-    return n;
+      if (nearest > limit2) n.fetch_add(1, std::memory_order_relaxed);
+    });
+    return n.load();
   };
-  // The operators hold the pairs of the last step's search; a particle's moves since are a
-  // fraction of dx, well inside the margin between the limit and the support.
+  // The operators of the step just ended; the particles have moved since by a fraction of dx,
+  // well inside the margin between the limit and the support.
   return count(m_.to_nodes, m_.nodes.position, m_.stress_points.position) +
          count(m_.to_stress_points, m_.stress_points.position, m_.nodes.position);
 }

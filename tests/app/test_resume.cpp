@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <fstream>
 #include <random>
+#include <sstream>
 #include <thread>
 
 #include <fmt/format.h>
@@ -251,6 +252,31 @@ TEST(Resume, V2WithReseededStressPointsResumesBitForBit) {
   const std::string key = "version = \"v2\"";
   text.replace(text.find(key), key.size(), key + "\nreseed = \"auto\"\nreseed_interval = 7\nreseed_distance = 0.75");
   interrupt_and_resume(text.c_str(), SIGTERM, 1, 14);
+}
+
+// particles.csv: the disorder, the mass and the regularisations at every output step (V2, 2D).
+TEST(Resume, V2ParticlesTableCountsTheReseedings) {
+  std::string text = kV2;
+  const std::string key = "version = \"v2\"";
+  text.replace(text.find(key), key.size(), key + "\nreseed = \"auto\"\nreseed_interval = 7\nreseed_distance = 0.75");
+  test::TempDir dir;
+  const std::string file = dir.write("case.toml", text);
+  ASSERT_EQ(wait_status(spawn({RKTSPH_BINARY, "run", file, "--out", dir.file("out"), "-q", "-j", "1"})), 0);
+  std::istringstream rows(test::read_text(dir.file("out/particles.csv")));
+  std::string line, last;
+  std::getline(rows, line);
+  EXPECT_EQ(line, "t,nn_min,nn_mean,nn_max,nn_cv,clustered,isolated,surface_nodes,mass,stress_points,reseeds,shifts");
+  int count = 0;
+  while (std::getline(rows, line)) last = line, ++count;
+  EXPECT_EQ(count, 21);  // t = 0 and every 0.05 s to 1 s
+  // The last row: 1 s, some re-seedings, no shifts.
+  std::vector<std::string> cells;
+  std::istringstream split(last);
+  for (std::string c; std::getline(split, c, ',');) cells.push_back(c);
+  ASSERT_EQ(cells.size(), 12u);
+  EXPECT_NEAR(std::stod(cells[0]), 1.0, 1e-3);  // the last step ends at or just past 1 s
+  EXPECT_GE(std::stol(cells[10]), 1);
+  EXPECT_EQ(cells[11], "0");
 }
 
 // Node shifting every 5 steps (its counters in the checkpoint; the shifted positions are the
