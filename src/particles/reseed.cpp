@@ -42,10 +42,12 @@ std::array<std::int64_t, Dim> unpack(std::int64_t key) {
 }
 
 // One node's share of one cell (eq. (5.2.1)).
+template <int Dim>
 struct Deposit {
   std::int64_t cell;
   int material;
   double volume, mass;
+  Vec<Dim> moment;      // volume times the node's position
   bool covers = false;  // a node lies within options.cover * dx of the cell's centre
 };
 
@@ -63,7 +65,7 @@ ReseedResult reseed_stress_points(const ParticleSet<Dim>& nodes, const Vec<Dim>&
   // Eq. (5.2.1): each node's volume and mass spread on the 2^Dim cell centres around it with
   // the multilinear (cloud-in-cell) weights.
   constexpr int kCorners = 1 << Dim;
-  std::vector<Deposit> deposits;
+  std::vector<Deposit<Dim>> deposits;
   deposits.reserve(static_cast<std::size_t>(nodes.owned()) * kCorners);
   for (Index i = 0; i < nodes.owned(); ++i) {
     const auto iu = static_cast<std::size_t>(i);
@@ -85,7 +87,8 @@ ReseedResult reseed_stress_points(const ParticleSet<Dim>& nodes, const Vec<Dim>&
         w *= up ? frac[du] : 1.0 - frac[du];
       }
       if (w <= 0.0) continue;
-      deposits.push_back({pack<Dim>(c), nodes.material[iu], w * nodes.volume[iu], w * nodes.mass(i)});
+      deposits.push_back({pack<Dim>(c), nodes.material[iu], w * nodes.volume[iu], w * nodes.mass(i),
+                          w * nodes.volume[iu] * nodes.position[iu]});
     }
     if (options.cover > 0.0) {
       // The cell whose centre the node is nearest, if within the cover window (per axis).
@@ -97,7 +100,7 @@ ReseedResult reseed_stress_points(const ParticleSet<Dim>& nodes, const Vec<Dim>&
         c[static_cast<std::size_t>(d)] = static_cast<std::int64_t>(cell);
         inside = inside && std::abs(s - cell - 0.5) < options.cover;
       }
-      if (inside) deposits.push_back({pack<Dim>(c), nodes.material[iu], 0.0, 0.0, true});
+      if (inside) deposits.push_back({pack<Dim>(c), nodes.material[iu], 0.0, 0.0, Vec<Dim>::Zero(), true});
     }
   }
   // The old stress points by cell: a new cell takes the material of the nearest old stress
@@ -140,11 +143,14 @@ ReseedResult reseed_stress_points(const ParticleSet<Dim>& nodes, const Vec<Dim>&
   };
 
   // Deterministic sums: by cell (x fastest), then material, then the deposits' own values.
-  std::sort(deposits.begin(), deposits.end(), [](const Deposit& a, const Deposit& b) {
+  std::sort(deposits.begin(), deposits.end(), [](const Deposit<Dim>& a, const Deposit<Dim>& b) {
     if (a.cell != b.cell) return a.cell < b.cell;
     if (a.material != b.material) return a.material < b.material;
     if (a.volume != b.volume) return a.volume < b.volume;
     if (a.mass != b.mass) return a.mass < b.mass;
+    for (int d = 0; d < Dim; ++d) {
+      if (a.moment[d] != b.moment[d]) return a.moment[d] < b.moment[d];
+    }
     return a.covers < b.covers;
   });
 
@@ -155,6 +161,7 @@ ReseedResult reseed_stress_points(const ParticleSet<Dim>& nodes, const Vec<Dim>&
   for (std::size_t k = 0; k < deposits.size();) {
     const std::int64_t cell = deposits[k].cell;
     double volume = 0.0, mass = 0.0, best_volume = -1.0;
+    Vec<Dim> moment = Vec<Dim>::Zero();
     int best_material = -1;
     bool covered = false;
     while (k < deposits.size() && deposits[k].cell == cell) {
@@ -163,6 +170,7 @@ ReseedResult reseed_stress_points(const ParticleSet<Dim>& nodes, const Vec<Dim>&
       for (; k < deposits.size() && deposits[k].cell == cell && deposits[k].material == m; ++k) {
         volume_m += deposits[k].volume;
         mass += deposits[k].mass;
+        moment += deposits[k].moment;
         covered = covered || deposits[k].covers;
       }
       volume += volume_m;
@@ -172,12 +180,16 @@ ReseedResult reseed_stress_points(const ParticleSet<Dim>& nodes, const Vec<Dim>&
       }
     }
     // The cell's fill (its deposited volume over its own) decides whether it holds a stress point.
-    if (volume < options.fill * cell_volume && !(covered && volume > 0.0)) continue;
+    const bool filled = volume >= options.fill * cell_volume;
+    if (!filled && !(covered && volume > 0.0)) continue;
     const auto c = unpack<Dim>(cell);
     Vec<Dim> centre;
     for (int d = 0; d < Dim; ++d) {
       centre[d] = origin[d] + (static_cast<double>(c[static_cast<std::size_t>(d)]) + 0.5) * options.dx;
     }
+    // A cell held by the cover window alone gets its stress point at the centroid of its
+    // deposits (inside the node cloud), not at its centre, which may lie beyond the surface.
+    if (!filled) centre = moment / volume;
     if (options.excluded && options.excluded(centre.data())) {
       ++result.excluded_cells;
       continue;

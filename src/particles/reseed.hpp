@@ -34,7 +34,8 @@ struct ReseedOptions {
   double dx = 0.0;    // the lattice spacing, m
   double fill = 0.5;  // the least filled fraction of a cell that gets a stress point
   /// A cell less filled gets one too where a node lies within cover * dx of its centre along
-  /// every axis (a thin front); 0: none. Below 1/2 no node of the undeformed lattice does.
+  /// every axis (a thin front), at the centroid of its deposits; 0: none. Below 1/2 no node of
+  /// the undeformed lattice does.
   double cover = 0.0;
   /// A cell centre where this is true gets no stress point (inside a rigid body); may be empty.
   std::function<bool(const double* x)> excluded;

@@ -48,7 +48,9 @@ Index ReseedStressPoints<Dim>::uncovered() const {
 
 template <int Dim>
 void ReseedStressPoints<Dim>::reseed(double t) {
-  const Vec<Dim> origin = m_.lattice.dx > 0.0 ? m_.lattice.origin : Vec<Dim>::Zero();
+  // Polygons and particle files carry no lattice of their own: the case's (geometry.origin),
+  // through which polygons are discretised.
+  const Vec<Dim> origin = m_.lattice.dx > 0.0 ? m_.lattice.origin : m_.setup.origin;
   reseed_stress_points<Dim>(m_.nodes, origin, options_, m_.stress_points, next_global_id_);
   m_.stress_points_changed();
   ++reseeds_;

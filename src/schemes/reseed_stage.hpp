@@ -52,9 +52,10 @@ class ReseedStressPoints final : public Stage {
   std::int64_t next_global_id_ = 0;
   long reseeds_ = 0;
   long steps_since_ = 0;
-  // The uncovered count just after the last re-seeding (particles the lattice cannot cover:
-  // detached nodes): only more than these triggers another (-1: to be measured).
-  Index baseline_ = 0;
+  // The uncovered count of the case's own arrangement (after the first step) or just after the
+  // last re-seeding (particles the lattice cannot cover: detached nodes): only more than these
+  // triggers another (-1: to be measured).
+  Index baseline_ = -1;
   Index uncovered_ = 0;
   bool pending_ = false;  // the next step re-seeds
   double first_time_ = -1.0, last_time_ = -1.0;

@@ -75,13 +75,22 @@ TEST(V2Reseed, ATranslatingBodyKeepsZeroStressUniformVelocityAndMass) {
   EXPECT_LT(stress, 1e-6);  // Pa, against rho c v ~ 3e5 Pa for a real velocity jump
   EXPECT_LT(dv, 1e-12);
   // The last re-seeding was at the start of this step: the stress points moved one step since.
+  // Inside, they are on cell centres; within a spacing of the faces the cover window's points
+  // sit at the centroids of their cells' deposits.
   const double travel = sim.dt() * Vec<2>(2.0, 1.0).norm();
-  for (const auto& x : sim.stress_points().position) EXPECT_LT(off_centre(x, 0.1), travel + 1e-12);
+  const Vec<2> shift = sim.time() * Vec<2>(2.0, 1.0);
+  for (const auto& x : sim.stress_points().position) {
+    const Vec<2> from_centre = (x - shift).cwiseAbs();
+    if (from_centre.maxCoeff() < 1.0 - 0.1) {
+      EXPECT_LT(off_centre(x, 0.1), travel + 1e-12) << x.transpose();
+    }
+  }
 }
 
 TEST(V2Reseed, TheAutomaticTriggerPutsDriftedStressPointsBackOnCellCentres) {
   const test::ThreadCount threads(1);
   Simulation<2> sim(block().reseed(ReseedSetting::automatic, 1).time(1.0, 0.5).build());
+  sim.step();  // the case's own arrangement: the baseline (none uncovered)
   // Drift every stress point by 0.8 dx along x: the left column of nodes is then 1.4 dx from
   // its nearest stress point.
   for (auto& x : sim.model().stress_points.position) x[0] += 0.08;
@@ -90,8 +99,8 @@ TEST(V2Reseed, TheAutomaticTriggerPutsDriftedStressPointsBackOnCellCentres) {
   sim.step();
   EXPECT_EQ(reseed_stage(sim).reseeds(), 1);
   EXPECT_EQ(sim.stress_points().size(), 400);
-  // At rest without loads the stress points stay where they were put.
-  for (const auto& x : sim.stress_points().position) EXPECT_LT(off_centre(x, 0.1), 1e-12);
+  // At rest without loads the stress points stay where they were put (a step's motion since).
+  for (const auto& x : sim.stress_points().position) EXPECT_LT(off_centre(x, 0.1), 1e-9);
   for (int n = 0; n < 5; ++n) sim.step();
   EXPECT_EQ(reseed_stage(sim).reseeds(), 1);  // nothing uncovered any more
   EXPECT_EQ(reseed_stage(sim).uncovered(), 0);
