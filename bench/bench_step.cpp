@@ -15,6 +15,7 @@
 #include "case/case_builder.hpp"
 #include "linear_solvers/pore_pressure.hpp"
 #include "operators/corrected_operator.hpp"
+#include "particles/reseed.hpp"
 #include "schemes/pressure_stage.hpp"
 #include "schemes/simulation.hpp"
 #include "schemes/v2_stages.hpp"
@@ -279,6 +280,31 @@ void BM_OperatorSetup(benchmark::State& state) {
                                                  benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 BENCHMARK(BM_OperatorSetup)->Arg(100000)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// One re-seeding of the stress points from a sheared node cloud (particles/reseed.hpp), one
+// thread: what solver.reseed costs each time it fires, against a V2 step (BM_V2Step).
+void BM_Reseed(benchmark::State& state) {
+  omp_set_num_threads(1);
+  const CaseSetup<2> setup = block_case(state.range(0));
+  LatticeParticles<2> disc = generate_lattice<2>(setup.blocks, setup.dx, setup.origin, {2000.0});
+  for (auto& x : disc.nodes.position) x[0] += 0.3 * x[1];  // a simple shear of 0.3
+  ReseedOptions options;
+  options.dx = setup.dx;
+  options.cover = 0.45;
+  std::int64_t next = 0;
+  ParticleSet<2> sp;
+  for (auto _ : state) {
+    state.PauseTiming();
+    sp = disc.stress_points;  // the set to replace, not timed
+    state.ResumeTiming();
+    benchmark::DoNotOptimize(reseed_stress_points<2>(disc.nodes, disc.lattice.origin, options, sp, next).after);
+  }
+  const double nodes = static_cast<double>(disc.nodes.size());
+  state.counters["nodes"] = nodes;
+  state.counters["us/node"] = benchmark::Counter(nodes * static_cast<double>(state.iterations()),
+                                                 benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+}
+BENCHMARK(BM_Reseed)->Arg(100000)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // The whole set-up of a run: lattice generation, operators, constraints, state.
 void BM_V1Setup(benchmark::State& state) {
