@@ -55,9 +55,9 @@ struct Region {
 /// later entry replaces an earlier one on the nodes both select.
 template <int Dim>
 struct InitialVelocitySpec {
-  std::string where;        // "case.toml, line 12, key 'initial_velocity'" for error messages
-  Region<Dim> region;       // no axis bounded: every node
-  int material = -1;        // index into CaseSetup::materials, -1: any
+  std::string where;                     // "case.toml, line 12, key 'initial_velocity'" for error messages
+  Region<Dim> region;                    // no axis bounded: every node
+  int material = -1;                     // index into CaseSetup::materials, -1: any
   Vec<Dim> velocity = Vec<Dim>::Zero();  // m/s
   /// 2D: v += omega e_z x (x - centre) (rad/s, counter-clockwise positive).
   double angular_velocity = 0.0;
@@ -80,7 +80,7 @@ struct BoundarySpec {
   /// On a polygon edge normal to no axis: the traction (normal, tangential) in Pa, tension
   /// positive, t = e_z x n (method-notes §3.9), imposed by the rotation of §3.7.
   std::optional<std::array<double, 2>> traction;
-  int function = -1;                             // index into CaseSetup::functions, -1 = 1
+  int function = -1;  // index into CaseSetup::functions, -1 = 1
   /// V1/V3: the velocity components are those of rigid body `body` (bodies/plates.hpp), not
   /// value * function; -1 = none. Made by the model from a [[body]], not read from [[boundary]].
   int body = -1;
@@ -249,7 +249,7 @@ struct CaseSetup {
   /// every reseed_interval steps; at most once per reseed_interval steps. A cell gets a stress
   /// point where the nodes fill at least reseed_fill of it (eq. (5.2.1)).
   ReseedSetting reseed = ReseedSetting::off;
-  long reseed_interval = 20;
+  long reseed_interval = 5;  // the reader's default for "periodic" is 20
   double reseed_fill = 0.5;
   double reseed_distance = 1.0;
   double reseed_cover = 0.45;  // solver.reseed_cover: less-filled cells with a node near the centre
@@ -263,7 +263,7 @@ struct CaseSetup {
   double shift_distance = 0.5;
 
   // output
-  double output_interval = 0.0;      // s; 0 = first and last state only
+  double output_interval = 0.0;  // s; 0 = first and last state only
   /// s of simulated time between checkpoints; empty = a tenth of the run; 0 = none but the one
   /// written when the run is interrupted (docs/output.md, "Interrupted runs").
   std::optional<double> checkpoint_interval;
