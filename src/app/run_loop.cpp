@@ -230,23 +230,36 @@ int run_loop(const LoopInput& in) {
       }
     }
   }
-  auto record_runout = [&] {
+  // What runout.csv and particles.csv share, measured once per output step (2D).
+  struct NodeMeasures {
+    io::Disorder disorder;
+    long surface = 0;  // flagged free-surface nodes
+    double mass = 0.0;
+  };
+  auto measure_nodes = [&] {
+    NodeMeasures m;
+    if constexpr (Dim == 2) {
+      const auto& set = solver.nodes();
+      m.disorder = io::particle_disorder(set.position, setup.dx);
+      if (const auto f = set.template find<double, 1>("free_surface"); f.valid()) {
+        for (Index i = 0; i < set.size(); ++i) m.surface += set.view(f)(i, 0) != 0.0 ? 1 : 0;
+      }
+      m.mass = solver.total_mass();
+    }
+    return m;
+  };
+  auto record_runout = [&](const NodeMeasures& m) {
     if constexpr (Dim == 2) {
       if (!runout_csv) return;
       const auto& set = solver.nodes();
       const double dx = setup.dx;
       double xmax = runout_x0, hmax = 0.0;
       for (const auto& p : set.position) xmax = std::max(xmax, p[0]), hmax = std::max(hmax, p[1] - runout_base);
-      const double mass = solver.total_mass();
       const io::DepositProfile p = io::deposit_profile(set.position, runout_x0, xmax + dx, dx, runout_base);
-      const io::Disorder d = io::particle_disorder(set.position, dx);
-      long surface = 0;
-      if (const auto f = set.template find<double, 1>("free_surface"); f.valid()) {
-        for (Index i = 0; i < set.size(); ++i) surface += set.view(f)(i, 0) != 0.0 ? 1 : 0;
-      }
+      const io::Disorder& d = m.disorder;
       runout_csv->append(fmt::format(
           "{:.10g},{:.10g},{:.10g},{:.10g},{},{},{:.6g},{:.6g},{:.6g},{:.6g},{},{},{:.15g}\n", solver.time(), p.front,
-          p.h.front(), hmax, p.detached, surface, d.min, d.mean, d.max, d.cv, d.clustered, d.isolated, mass));
+          p.h.front(), hmax, p.detached, m.surface, d.min, d.mean, d.max, d.cv, d.clustered, d.isolated, m.mass));
       std::string profile =
           fmt::format("# t = {:.10g} s; h above the base y = {:.10g} m\nx,h,count\n", solver.time(), runout_base);
       for (std::size_t k = 0; k < p.h.size(); ++k) {
@@ -269,25 +282,21 @@ int run_loop(const LoopInput& in) {
           "t,nn_min,nn_mean,nn_max,nn_cv,clustered,isolated,surface_nodes,mass,stress_points,reseeds,shifts\n");
     }
   }
-  auto record_particles = [&] {
-    if constexpr (Dim == 2) {
-      if (!particles_csv) return;
-      const auto& set = solver.nodes();
-      const io::Disorder d = io::particle_disorder(set.position, setup.dx);
-      long surface = 0;
-      if (const auto f = set.template find<double, 1>("free_surface"); f.valid()) {
-        for (Index i = 0; i < set.size(); ++i) surface += set.view(f)(i, 0) != 0.0 ? 1 : 0;
-      }
-      particles_csv->append(fmt::format(
-          "{:.10g},{:.6g},{:.6g},{:.6g},{:.6g},{},{},{},{:.15g},{},{},{}\n", solver.time(), d.min, d.mean, d.max, d.cv,
-          d.clustered, d.isolated, surface, solver.total_mass(), solver.stress_points().size(),
-          reseed_stage != nullptr ? reseed_stage->reseeds() : 0L, shift_stage != nullptr ? shift_stage->shifts() : 0L));
-    }
+  auto record_particles = [&](const NodeMeasures& m) {
+    if (!particles_csv) return;
+    const io::Disorder& d = m.disorder;
+    particles_csv->append(fmt::format(
+        "{:.10g},{:.6g},{:.6g},{:.6g},{:.6g},{},{},{},{:.15g},{},{},{}\n", solver.time(), d.min, d.mean, d.max, d.cv,
+        d.clustered, d.isolated, m.surface, m.mass, solver.stress_points().size(),
+        reseed_stage != nullptr ? reseed_stage->reseeds() : 0L, shift_stage != nullptr ? shift_stage->shifts() : 0L));
   };
   auto record_bodies = [&] {
     if (bodies_csv) bodies_csv->append(bodies->csv_rows(solver.time()));
-    record_runout();
-    record_particles();
+    if (runout_csv || particles_csv) {
+      const NodeMeasures m = measure_nodes();
+      record_runout(m);
+      record_particles(m);
+    }
   };
   io::PvdCollection node_pvd((out / "nodes.pvd").string());
   io::PvdCollection elem_pvd((out / "elements.pvd").string());
@@ -620,9 +629,9 @@ int run_loop(const LoopInput& in) {
           ps.solves, pressure->implicit_faces() ? "BiCGSTAB" : "PCG", ps.mean_iterations(), ps.max_iterations,
           ps.last_error, seconds > 0 ? 100.0 * pressure->seconds() / seconds : 0.0);
     }
-    if (const auto* reseed = solver.scheme().template find<ReseedStressPoints<Dim>>()) {
+    if (reseed_stage != nullptr) {
       std::cerr << fmt::format("stress points re-seeded {} times (first at t = {:.4g} s); {} stress points now\n",
-                               reseed->reseeds(), reseed->first_time(), solver.stress_points().size());
+                               reseed_stage->reseeds(), reseed_stage->first_time(), solver.stress_points().size());
     }
     const double node_steps = static_cast<double>(solver.nodes().size()) *
                               static_cast<double>(solver.step_count() - std::max(0L, loop.resumed_from));

@@ -160,10 +160,11 @@ class CaseBuilder {
     c_.detect_free_surface = detect;
     return *this;
   }
-  /// solver.reseed (V2): when to re-seed the stress points, at most every `interval` steps.
-  CaseBuilder& reseed(ReseedSetting when, long interval = 20) {
+  /// solver.reseed (V2): when to re-seed the stress points, at most every `interval` steps
+  /// (by default the reader's: 5 for "auto", 20 for "periodic").
+  CaseBuilder& reseed(ReseedSetting when, long interval = 0) {
     c_.reseed = when;
-    c_.reseed_interval = interval;
+    c_.reseed_interval = interval > 0 ? interval : (when == ReseedSetting::periodic ? 20 : 5);
     return *this;
   }
   /// solver.shift (V2): when to shift the nodes, at most every `interval` steps.

@@ -253,7 +253,7 @@ struct CaseSetup {
   double reseed_fill = 0.5;
   double reseed_distance = 1.0;
   double reseed_cover = 0.45;  // solver.reseed_cover: less-filled cells with a node near the centre
-  /// V2 in 2D/3D: the nodes shifted down their concentration gradient (method-notes §5.2,
+  /// V2 in 2D/3D: the nodes pushed apart where they crowd (method-notes §5.2,
   /// "Regularisation", eqs. (5.2.5)-(5.2.7); solver.shift): never, when two nodes come closer
   /// than shift_distance * dx (checked every shift_interval steps), or every shift_interval
   /// steps; shift_strength is beta of eq. (5.2.6).

@@ -138,9 +138,10 @@ void ShiftNodes<Dim>::shift(const StepContext& c) {
     }
     if (neighbours == 0 || !(std::abs(M.determinant()) > kMinDeterminant)) return;
     rbar /= neighbours;
-    // Eq. (5.2.6): beta rbar^2 times the push, capped; on the free surface of the last
-    // detection and at a body's contact along them only (the normal part removed), so that the
-    // surface and the contact stay where they are.
+    // Where the support is cut by the free surface or a held face, the missing neighbours
+    // beyond it would push the nodes across it (and at corners along the other face): they stay.
+    if (cut) return;
+    // Eq. (5.2.6): beta rbar^2 times the push, capped.
     Vec<Dim> dr = strength * rbar * rbar * push;
     if constexpr (Dim == 2) {
       // On a body and within a support of one: along the body only (its normal removed), so that
@@ -157,10 +158,6 @@ void ShiftNodes<Dim>::shift(const StepContext& c) {
         if (slots > 1) return;
       }
     }
-    if (corners_ != nullptr && iu < corners_->size() && (*corners_)[iu] != 0) return;  // two faces: stays
-    // Where the support is cut by the free surface or a held face, the missing neighbours
-    // beyond it would push the nodes across it (and at corners along the other face): they stay.
-    if (cut) return;
     const double len = dr.norm();
     if (len > cap) dr *= cap / len;
     if (len == 0.0) return;

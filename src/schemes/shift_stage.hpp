@@ -1,7 +1,7 @@
 #pragma once
-// V2's second regularisation (method-notes §5.2, "Regularisation"): the nodes shifted down the
-// gradient of their own concentration, eqs. (5.2.5)-(5.2.7), with their fields carried to the
-// new positions to first order. A shifted node is no longer a material point; its fields are
+// V2's second regularisation (method-notes §5.2, "Regularisation"): the nodes pushed apart where
+// they crowd (the inverse-square shifting of Xu et al. 2009), eqs. (5.2.5)-(5.2.7), with their
+// fields carried to the new positions to first order. A shifted node is no longer a material point; its fields are
 // those of the material now at its position. Off by default (solver.shift).
 #include <cstdint>
 #include <string>
@@ -21,8 +21,8 @@ class ShiftNodes final : public Stage {
   /// shift) and ContactSelect (whose contact nodes move along their body only); before the
   /// free surface is detected on the shifted positions. Nodes whose support reaches the free
   /// surface of the last detection or a node held by a boundary entry stay.
-  /// `corners`: the corner flags of the last detection (DetectFreeSurface::corners()); corner
-  /// nodes are not shifted.
+  /// `corners`: the corner flags of the last detection (DetectFreeSurface::corners()), sized
+  /// once the surface has been detected: no shift before that.
   ShiftNodes(StaggeredModel<Dim>& model, RebuildOperators<Dim>& rebuild, const RigidContact* contact,
              const std::vector<std::uint8_t>* corners);
   std::string_view name() const override { return "shift_nodes"; }
