@@ -1,5 +1,6 @@
 #pragma once
 // Cubic B-spline kernel of Monaghan & Lattanzio (method-notes §3.1), support radius 2h.
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -52,6 +53,24 @@ class CubicSplineKernel {
       dw = 0.0;
     }
   }
+
+  /// W(r) and h W'(r)/r for 0 <= r < 2h, without branches, so that loops over the pairs of a
+  /// row vectorise (`#pragma omp simd`): both pieces are evaluated and one is selected. h W'/r
+  /// is finite at r = 0 (-2 alpha/h), where grad W = W'/r x_ab vanishes with x_ab; callers
+  /// must keep r < 2h (the second piece is not cut off beyond it).
+  static void value_and_scaled_derivative(double r, double inv_h, double alpha, double& w, double& h_dw_over_r) {
+    const double q = r * inv_h;
+    const double t = 2.0 - q;
+    const double w_inner = alpha * (2.0 / 3.0 - q * q + 0.5 * q * q * q);
+    const double w_outer = alpha * (1.0 / 6.0) * t * t * t;
+    const double d_inner = alpha * inv_h * (-2.0 + 1.5 * q);
+    const double d_outer = -0.5 * alpha * inv_h * t * t / std::max(q, 1.0);
+    const bool inner = q < 1.0;
+    w = inner ? w_inner : w_outer;
+    h_dw_over_r = inner ? d_inner : d_outer;
+  }
+  double inv_h() const { return inv_h_; }
+  double alpha() const { return alpha_; }
 
   /// grad_a W_ab = W'(r) (x_a - x_b) / r, with x_ab = x_a - x_b.
   Vec<Dim> gradient(const Vec<Dim>& x_ab) const {

@@ -2,6 +2,8 @@
 
 #include <cmath>
 #include <numbers>
+#include <span>
+#include <vector>
 
 #include <Eigen/Dense>
 
@@ -25,6 +27,65 @@ double smallest_eigenvalue(const Mat<Dim>& B) {
   }
 }
 
+// The pairs of one node in arrays (structure of arrays), kept per thread between calls.
+template <int Dim>
+struct PairArrays {
+  std::vector<double> x[Dim];  // x_I - x_J
+  std::vector<double> d2;
+  std::vector<double> volume;
+  std::vector<double> factor;  // V_J W'(r)/r
+  std::size_t n = 0;
+
+  void gather(std::span<const Index> row, const Vec<Dim>& xi, const ParticleSet<Dim>& set, double r2) {
+    if (d2.size() < row.size()) {
+      for (auto& v : x) v.resize(row.size());
+      d2.resize(row.size());
+      volume.resize(row.size());
+      factor.resize(row.size());
+    }
+    std::size_t count = 0;
+    for (const Index j : row) {
+      const auto ju = static_cast<std::size_t>(j);
+      const Vec<Dim> x_ij = xi - set.position[ju];
+      const double s = x_ij.squaredNorm();
+      for (int d = 0; d < Dim; ++d) x[d][count] = x_ij[d];
+      d2[count] = s;
+      volume[count] = set.volume[ju];
+      count += s < r2 ? 1 : 0;
+    }
+    n = count;
+  }
+
+  // B = sum_J V_J (x_J - x_I) (x) grad_I W_IJ (symmetric: grad_I W_IJ = W'/r x_IJ) and
+  // g = sum_J V_J grad_I W_IJ.
+  void moments(double inv_h, double alpha, Mat<Dim>& B, Vec<Dim>& g) {
+    const double* s2 = d2.data();
+    const double* V = volume.data();
+    double* f = factor.data();
+#pragma omp simd
+    for (std::size_t k = 0; k < n; ++k) {
+      double W, h_dw_over_r;
+      CubicSplineKernel<Dim>::value_and_scaled_derivative(std::sqrt(s2[k]), inv_h, alpha, W, h_dw_over_r);
+      f[k] = V[k] * h_dw_over_r * inv_h;
+    }
+    for (int d = 0; d < Dim; ++d) {
+      const double* xd = x[d].data();
+      double sg = 0.0;
+#pragma omp simd reduction(+ : sg)
+      for (std::size_t k = 0; k < n; ++k) sg += f[k] * xd[k];
+      g[d] = sg;
+      for (int e = d; e < Dim; ++e) {
+        const double* xe = x[e].data();
+        double sb = 0.0;
+#pragma omp simd reduction(+ : sb)
+        for (std::size_t k = 0; k < n; ++k) sb += f[k] * xd[k] * xe[k];
+        B(d, e) = -sb;
+        B(e, d) = -sb;
+      }
+    }
+  }
+};
+
 }  // namespace
 
 template <int Dim>
@@ -37,6 +98,7 @@ void detect_free_surface(const ParticleSet<Dim>& set, const Relation<Dim>& relat
   FreeSurfaceScratch<Dim>& work = scratch != nullptr ? *scratch : local;
   const Index n = set.size();
   const double h = kernel.h();
+  const double inv_h = kernel.inv_h(), alpha = kernel.alpha();
   const double r2 = kernel.support_radius() * kernel.support_radius();
   const double near2 = 2.0 * h * h;  // (sqrt(2) h)^2
   flags.assign(static_cast<std::size_t>(n), 0);
@@ -47,19 +109,14 @@ void detect_free_surface(const ParticleSet<Dim>& set, const Relation<Dim>& relat
   exec::particle_for(policy, n, [&](Index i) {
     const auto iu = static_cast<std::size_t>(i);
     const Vec<Dim>& xi = set.position[iu];
-    Mat<Dim> B = Mat<Dim>::Zero();
-    Vec<Dim> g = Vec<Dim>::Zero();
-    for (const Index j : relation.row(i)) {
-      if (j == i) continue;
-      const Vec<Dim> x_ij = xi - set.position[static_cast<std::size_t>(j)];
-      const double d2 = x_ij.squaredNorm();
-      if (d2 >= r2 || d2 == 0.0) continue;
-      const double r = std::sqrt(d2);
-      const Vec<Dim> grad = kernel.derivative(r) / r * x_ij;  // grad_I W_IJ
-      const double V = set.volume[static_cast<std::size_t>(j)];
-      B -= V * x_ij * grad.transpose();  // (x_J - x_I) (x) grad_I W_IJ
-      g += V * grad;
-    }
+    // The neighbours in the support, gathered branch-free into arrays (a coincident particle,
+    // d2 = 0, contributes nothing: its x_IJ is zero), then B and g summed in loops the compiler
+    // vectorises (the square root and the kernel's piece 8 pairs at a time).
+    static thread_local PairArrays<Dim> pairs;
+    pairs.gather(relation.row(i), xi, set, r2);
+    Mat<Dim> B;
+    Vec<Dim> g;
+    pairs.moments(inv_h, alpha, B, g);
     lambda[iu] = smallest_eigenvalue<Dim>(B);
     Vec<Dim> nu = std::abs(B.determinant()) > 1e-12 ? Vec<Dim>(-(B.inverse() * g)) : Vec<Dim>(-g);
     const double len = nu.norm();

@@ -54,6 +54,25 @@ inline void interpolate_run(const CorrectedOperator<Dim>& op, const double* src,
                             double (&acc)[Dim + 1][CorrectedOperator<Dim>::kMaxRun * N]) {
   const Index a0 = op.run_start[static_cast<std::size_t>(r)], a1 = op.run_start[static_cast<std::size_t>(r) + 1];
   const auto p = static_cast<std::size_t>(op.pattern[static_cast<std::size_t>(a0)]);
+  if (a1 - a0 == 1) {
+    // A run of one row (every row of a rebuilt operator, V2): the N values of a source in
+    // registers, the same sums in the same order as run_sums, without its variable-width loop.
+    const double* base = src + static_cast<std::size_t>(op.base[static_cast<std::size_t>(a0)]) * N;
+    double a[Dim + 1][N] = {};
+    for (Index k = op.pattern_start[p]; k < op.pattern_start[p + 1]; ++k) {
+      const auto ku = static_cast<std::size_t>(k);
+      const double* s = base + static_cast<std::size_t>(op.offset[ku]) * N;
+      const double w0 = op.interp[ku];
+      for (int l = 0; l < N; ++l) a[0][l] += w0 * s[l];
+      for (int d = 0; d < Dim; ++d) {
+        const double g = op.grad[ku][static_cast<std::size_t>(d)];
+        for (int l = 0; l < N; ++l) a[1 + d][l] += g * s[l];
+      }
+    }
+    for (int q = 0; q <= Dim; ++q)
+      for (int l = 0; l < N; ++l) acc[q][l] = a[q][l];
+    return;
+  }
   double* sums[Dim + 1];
   for (int q = 0; q <= Dim; ++q) sums[q] = acc[q];
   run_sums<Dim + 1, 16>(
