@@ -25,6 +25,7 @@
 #include "io/runout.hpp"
 #include "io/vtu_writer.hpp"
 #include "rktsph/version.hpp"
+#include "schemes/deactivate_stage.hpp"
 #include "schemes/pressure_stage.hpp"
 #include "schemes/reseed_stage.hpp"
 #include "schemes/shift_stage.hpp"
@@ -274,21 +275,25 @@ int run_loop(const LoopInput& in) {
   const ReseedStressPoints<Dim>* reseed_stage = solver.scheme().template find<ReseedStressPoints<Dim>>();
   const ShiftNodes<Dim>* shift_stage = nullptr;
   if constexpr (Dim >= 2) shift_stage = solver.scheme().template find<ShiftNodes<Dim>>();
+  const DeactivateOutside<Dim>* deactivate_stage = solver.scheme().template find<DeactivateOutside<Dim>>();
   if (Dim == 2 && setup.version == "v2") {
     const bool kept = resuming && in.checkpoint->has("run/particles_bytes");
     particles_csv.emplace((out / "particles.csv").string(), kept ? in.checkpoint->integer("run/particles_bytes") : -1);
     if (!kept) {
       particles_csv->append(
-          "t,nn_min,nn_mean,nn_max,nn_cv,clustered,isolated,surface_nodes,mass,stress_points,reseeds,shifts\n");
+          "t,nn_min,nn_mean,nn_max,nn_cv,clustered,isolated,surface_nodes,mass,stress_points,reseeds,shifts,"
+          "deactivated,deactivated_mass\n");
     }
   }
   auto record_particles = [&](const NodeMeasures& m) {
     if (!particles_csv) return;
     const io::Disorder& d = m.disorder;
     particles_csv->append(fmt::format(
-        "{:.10g},{:.6g},{:.6g},{:.6g},{:.6g},{},{},{},{:.15g},{},{},{}\n", solver.time(), d.min, d.mean, d.max, d.cv,
-        d.clustered, d.isolated, m.surface, m.mass, solver.stress_points().size(),
-        reseed_stage != nullptr ? reseed_stage->reseeds() : 0L, shift_stage != nullptr ? shift_stage->shifts() : 0L));
+        "{:.10g},{:.6g},{:.6g},{:.6g},{:.6g},{},{},{},{:.15g},{},{},{},{},{:.15g}\n", solver.time(), d.min, d.mean,
+        d.max, d.cv, d.clustered, d.isolated, m.surface, m.mass, solver.stress_points().size(),
+        reseed_stage != nullptr ? reseed_stage->reseeds() : 0L, shift_stage != nullptr ? shift_stage->shifts() : 0L,
+        deactivate_stage != nullptr ? deactivate_stage->deactivated() : 0L,
+        deactivate_stage != nullptr ? deactivate_stage->deactivated_mass() : 0.0));
   };
   auto record_bodies = [&] {
     if (bodies_csv) bodies_csv->append(bodies->csv_rows(solver.time()));

@@ -173,6 +173,11 @@ class CaseBuilder {
     c_.shift_interval = interval;
     return *this;
   }
+  /// solver.domain_min / domain_max (V2): particles leaving the box are deactivated.
+  CaseBuilder& domain_box(const Vec<Dim>& lo, const Vec<Dim>& hi) {
+    c_.domain_box = std::array<Vec<Dim>, 2>{lo, hi};
+    return *this;
+  }
   CaseBuilder& fluid(const FluidSpec& f) {
     c_.fluid = f;
     return *this;
@@ -189,6 +194,7 @@ class CaseBuilder {
     auto fail = [&](const std::string& what) { throw InputError(fmt::format("{}: {}", c.file, what)); };
     if (c.detect_free_surface && (c.version != "v2" || Dim < 2))
       fail("free-surface detection needs the V2 scheme in 2D or 3D");
+    if (c.domain_box && c.version != "v2") fail("a domain box needs the V2 scheme");
     if (!(c.dx > 0.0)) fail("the spacing must be > 0");
     if (!(c.jitter.fraction >= 0.0 && c.jitter.fraction < kMaxJitterFraction))
       fail(fmt::format("the jitter must lie in [0, {}) spacings", kMaxJitterFraction));

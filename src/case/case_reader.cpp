@@ -366,6 +366,20 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     c.shift_distance = s->number("shift_distance", 0.5);
     s->require(c.shift_distance > 0.0 && c.shift_distance <= 1.0, "shift_distance",
                fmt::format("must lie in (0, 1] (a multiple of dx), got {}", c.shift_distance));
+    if (s->has("domain_min") || s->has("domain_max")) {
+      if (!s->has("domain_min")) s->fail("domain_max", "needs solver.domain_min as well (the box's lower corner)");
+      if (!s->has("domain_max")) s->fail("domain_min", "needs solver.domain_max as well (the box's upper corner)");
+      s->require(c.version == "v2", "domain_min",
+                 "a domain box needs solver.version = \"v2\" (only large deformation moves the particles)");
+      const Vec<Dim> lo = read_vector<Dim>(*s, "domain_min"), hi = read_vector<Dim>(*s, "domain_max");
+      for (int d = 0; d < Dim; ++d) {
+        s->require(
+            hi[d] > lo[d], "domain_max",
+            fmt::format("must exceed domain_min in every component (axis {}: {} <= {})", kAxisNames[d], hi[d], lo[d]));
+      }
+      c.domain_box = std::array<Vec<Dim>, 2>{lo, hi};
+      c.domain_where = s->where("domain_min");
+    }
     c.filter_strength = s->number("filter_strength", 0.5);
     s->require(c.filter_strength > 0.0 && c.filter_strength <= 1.0, "filter_strength",
                fmt::format("must lie in (0, 1], got {}", c.filter_strength));

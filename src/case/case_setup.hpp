@@ -2,6 +2,7 @@
 // A case as the schemes see it: plain data, made by the case-file reader (case/case_reader.hpp,
 // which alone knows TOML) or in code (case/case_builder.hpp). Every key is documented in
 // docs/case-format.md.
+#include <array>
 #include <memory>
 #include <optional>
 #include <string>
@@ -261,6 +262,11 @@ struct CaseSetup {
   long shift_interval = 20;
   double shift_strength = 0.01;
   double shift_distance = 0.5;
+  /// V2: the domain box [min, max] (solver.domain_min / domain_max): particles that leave it
+  /// are deactivated (schemes/deactivate_stage.hpp); empty: no box. `domain_where` names the
+  /// keys' file and line for the errors found once the particles exist.
+  std::optional<std::array<Vec<Dim>, 2>> domain_box;
+  std::string domain_where;
 
   // output
   double output_interval = 0.0;  // s; 0 = first and last state only

@@ -16,6 +16,7 @@
 #include <memory>
 #include <utility>
 
+#include "schemes/deactivate_stage.hpp"
 #include "schemes/registry.hpp"
 #include "schemes/reseed_stage.hpp"
 #include "schemes/shift_stage.hpp"
@@ -88,6 +89,9 @@ std::unique_ptr<Scheme> make_v2_scheme(StaggeredModel<Dim>& model) {
     }
   }
   if (surface != nullptr) scheme->add(std::make_unique<SurfaceTractionFree<Dim>>(*surface));
+  // Last but the re-seeding check: the particles outside the domain box frozen (and the ones
+  // frozen before put back) on the step's final positions.
+  if (model.setup.domain_box) scheme->add(std::make_unique<DeactivateOutside<Dim>>(model));
   if (reseed != nullptr) scheme->add(std::make_unique<ReseedCheck<Dim>>(*reseed));
   return scheme;
 }

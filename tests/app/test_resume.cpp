@@ -265,7 +265,8 @@ TEST(Resume, V2ParticlesTableCountsTheReseedings) {
   std::istringstream rows(test::read_text(dir.file("out/particles.csv")));
   std::string line, last;
   std::getline(rows, line);
-  EXPECT_EQ(line, "t,nn_min,nn_mean,nn_max,nn_cv,clustered,isolated,surface_nodes,mass,stress_points,reseeds,shifts");
+  EXPECT_EQ(line, "t,nn_min,nn_mean,nn_max,nn_cv,clustered,isolated,surface_nodes,mass,stress_points,reseeds,shifts,"
+                  "deactivated,deactivated_mass");
   int count = 0;
   while (std::getline(rows, line)) last = line, ++count;
   EXPECT_EQ(count, 21);  // t = 0 and every 0.05 s to 1 s
@@ -273,10 +274,11 @@ TEST(Resume, V2ParticlesTableCountsTheReseedings) {
   std::vector<std::string> cells;
   std::istringstream split(last);
   for (std::string c; std::getline(split, c, ',');) cells.push_back(c);
-  ASSERT_EQ(cells.size(), 12u);
+  ASSERT_EQ(cells.size(), 14u);
   EXPECT_NEAR(std::stod(cells[0]), 1.0, 1e-3);  // the last step ends at or just past 1 s
   EXPECT_GE(std::stol(cells[10]), 1);
   EXPECT_EQ(cells[11], "0");
+  EXPECT_EQ(cells[12], "0");  // no domain box: nothing deactivated
 }
 
 // Node shifting every 5 steps (its counters in the checkpoint; the shifted positions are the

@@ -194,6 +194,40 @@ TEST(InputErrors, ShiftStrengthOutOfRange) {
   expect_error_at(o, line_of(text, "shift_strength"), "solver.shift_strength", {"(0, 0.1]"});
 }
 
+TEST(InputErrors, DomainBoxNeedsBothCorners) {
+  test::TempDir dir;
+  const std::string text = replace(kBase, "[time]", "[solver]\nversion = \"v2\"\ndomain_min = [-1.0, -1.0]\n[time]");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "domain_min"), "solver.domain_min", {"domain_max"});
+}
+
+TEST(InputErrors, DomainBoxNeedsV2) {
+  test::TempDir dir;
+  const std::string text =
+      replace(kBase, "[time]", "[solver]\ndomain_min = [-1.0, -1.0]\ndomain_max = [5.0, 5.0]\n[time]");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "domain_min"), "solver.domain_min", {"v2"});
+}
+
+TEST(InputErrors, DomainBoxMaxBelowMin) {
+  test::TempDir dir;
+  const std::string text = replace(
+      kBase, "[time]", "[solver]\nversion = \"v2\"\ndomain_min = [-1.0, -1.0]\ndomain_max = [5.0, -2.0]\n[time]");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "domain_max"), "solver.domain_max", {"axis y"});
+}
+
+TEST(InputErrors, DomainBoxThatCutsTheBody) {
+  test::TempDir dir;
+  const std::string text = replace(
+      kBase, "[time]", "[solver]\nversion = \"v2\"\ndomain_min = [-1.0, -1.0]\ndomain_max = [1.0, 5.0]\n[time]");
+  const auto o = run_case_text(dir, text);
+  // Found once the particles exist: the message names the key's line and the first particle out.
+  EXPECT_NE(o.status, 0);
+  EXPECT_TRUE(names_line(o.err, line_of(text, "domain_min"))) << o.err;
+  EXPECT_NE(o.err.find("outside the domain box"), std::string::npos) << o.err;
+}
+
 TEST(InputErrors, PressureFilterOutOfRange) {
   test::TempDir dir;
   const std::string text = replace(kBase, "[time]", "[solver]\npressure_filter = -1.0\n[time]");
