@@ -16,15 +16,24 @@ void Relation<Dim>::build(const std::vector<Vec<Dim>>& targets, const std::vecto
   const CellList<Dim> cells(sources, options.radius, options.subdivisions);
   const auto nt = static_cast<Index>(targets.size());
   const Index nblocks = (nt + kRelationBlock - 1) / kRelationBlock;
-  std::vector<std::vector<Index>> block_indices(static_cast<std::size_t>(nblocks));
-  std::vector<Index> counts(static_cast<std::size_t>(nt));
+  // The blocks' rows, kept from build to build by the calling thread (a V2 run searches again
+  // every few steps; fresh vectors each time cost their growth copies and page faults), shared
+  // by every relation that thread builds, so they hold one relation's pairs at most.
+  // (References, so that the team's threads use the caller's vectors, not their own.)
+  static thread_local std::vector<std::vector<Index>> pool;
+  static thread_local std::vector<Index> pool_counts;
+  std::vector<std::vector<Index>>& block_indices = pool;
+  std::vector<Index>& counts = pool_counts;
+  if (block_indices.size() < static_cast<std::size_t>(nblocks)) block_indices.resize(static_cast<std::size_t>(nblocks));
+  counts.resize(static_cast<std::size_t>(nt));
   const double r2 = options.radius * options.radius;
   exec::particle_for(
       policy, nblocks,
       [&](Index blk) {
-        std::vector<typename CellList<Dim>::Hit> hits;
-        std::vector<Index> row;
+        static thread_local std::vector<typename CellList<Dim>::Hit> hits;
+        static thread_local std::vector<Index> row;
         auto& out = block_indices[static_cast<std::size_t>(blk)];
+        out.clear();
         const Index end = std::min(nt, (blk + 1) * kRelationBlock);
         for (Index a = blk * kRelationBlock; a < end; ++a) {
           const std::size_t n = cells.collect(targets[static_cast<std::size_t>(a)], r2, hits);
@@ -42,9 +51,9 @@ void Relation<Dim>::build(const std::vector<Vec<Dim>>& targets, const std::vecto
         offsets_[static_cast<std::size_t>(a)] + counts[static_cast<std::size_t>(a)];
   indices_.clear();
   indices_.reserve(static_cast<std::size_t>(offsets_.back()));
-  for (auto& b : block_indices) {
+  for (Index blk = 0; blk < nblocks; ++blk) {
+    const auto& b = block_indices[static_cast<std::size_t>(blk)];
     indices_.insert(indices_.end(), b.begin(), b.end());
-    b = {};
   }
   ++version_;
 }
