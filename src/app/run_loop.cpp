@@ -634,6 +634,33 @@ int run_loop(const LoopInput& in) {
           ps.solves, pressure->implicit_faces() ? "BiCGSTAB" : "PCG", ps.mean_iterations(), ps.max_iterations,
           ps.last_error, seconds > 0 ? 100.0 * pressure->seconds() / seconds : 0.0);
     }
+    // V2: what rebuilding the neighbours and operators cost, the surface, the domain box.
+    auto figure = [](const Stage* stage, const std::string& key) {
+      for (const auto& [k, v] : stage->report()) {
+        if (k == key) return v;
+      }
+      return 0.0;
+    };
+    auto share = [&](double part) { return seconds > 0 ? 100.0 * part / seconds : 0.0; };
+    if (const Stage* rebuild = solver.scheme().template find<RebuildOperators<Dim>>(); rebuild != nullptr) {
+      std::cerr << fmt::format(
+          "neighbours: {:.0f} searches ({:.3g} s, {:.0f} % of the loop); operators rebuilt {:.0f} times ({:.3g} s, "
+          "{:.0f} %)\n",
+          figure(rebuild, "neighbour_searches"), figure(rebuild, "neighbour_search_seconds"),
+          share(figure(rebuild, "neighbour_search_seconds")), figure(rebuild, "operator_builds"),
+          figure(rebuild, "operator_build_seconds"), share(figure(rebuild, "operator_build_seconds")));
+    }
+    if (const Stage* surface = solver.scheme().template find<DetectFreeSurface<Dim>>(); surface != nullptr) {
+      std::cerr << fmt::format("free surface: {:.0f} nodes at the last step; detection {:.3g} s ({:.0f} %)\n",
+                               figure(surface, "surface_nodes_last_step"), figure(surface, "detection_seconds"),
+                               share(figure(surface, "detection_seconds")));
+    }
+    if (deactivate_stage != nullptr && deactivate_stage->deactivated() > 0) {
+      std::cerr << fmt::format(
+          "domain box: {} particles deactivated (first at t = {:.4g} s), {:.6g} kg (per metre in 2D) of mass\n",
+          deactivate_stage->deactivated(), figure(deactivate_stage, "first_deactivation_time"),
+          deactivate_stage->deactivated_mass());
+    }
     if (reseed_stage != nullptr) {
       std::cerr << fmt::format("stress points re-seeded {} times (first at t = {:.4g} s); {} stress points now\n",
                                reseed_stage->reseeds(), reseed_stage->first_time(), solver.stress_points().size());

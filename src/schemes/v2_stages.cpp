@@ -123,6 +123,11 @@ void DetectFreeSurface<Dim>::run(const StepContext&) {
       for (std::size_t i = 0; i < nn; ++i) excluded_[i] = fixed_excluded_[i] | touching[i];
     }
   }
+  // Nodes without volume (deactivated outside the domain box, schemes/deactivate_stage.hpp)
+  // are no part of the body: never flagged.
+  for (std::size_t i = 0; i < nn; ++i) {
+    if (m_.nodes.volume[i] == 0.0) excluded_[i] = 1;
+  }
   detect_free_surface<Dim>(m_.nodes, rebuild_.node_neighbours(), m_.kernel, FreeSurfaceOptions{}, previous_, excluded_,
                            flags_, normals_, m_.policy, &corners_, &scratch_);
   unflagged_by_bodies_ = 0;

@@ -43,6 +43,7 @@ TEST(V2DomainBox, ParticlesLeavingTheBoxAreFrozenAndTheRestGoesOn) {
   const auto active = sim.nodes().find<double, 1>("active");
   ASSERT_TRUE(active.valid());
   const auto a = sim.nodes().view(active);
+  const auto flags = sim.nodes().view(sim.nodes().find<double, 1>("free_surface"));
   const auto v = sim.node_velocity();
   long frozen = 0;
   double worst = 0.0;
@@ -53,6 +54,7 @@ TEST(V2DomainBox, ParticlesLeavingTheBoxAreFrozenAndTheRestGoesOn) {
       EXPECT_EQ(sim.nodes().volume[static_cast<std::size_t>(i)], 0.0);
       EXPECT_EQ(v(i, 0), 0.0);
       EXPECT_EQ(v(i, 1), 0.0);
+      EXPECT_EQ(flags(i, 0), 0.0);  // not part of the body's surface
       // Frozen where it crossed: within one step's travel of the face.
       EXPECT_GT(x[0], 1.25);
       EXPECT_LT(x[0], 1.25 + 1.01 * kSpeed * sim.dt());
