@@ -207,6 +207,14 @@ int run_loop(const LoopInput& in) {
     bodies_csv.emplace((out / "bodies.csv").string(), resuming ? in.checkpoint->integer("run/bodies_bytes") : -1);
     if (!resuming) bodies_csv->append(body_csv_header());
   }
+  // contact.csv (V2's contact): the contact pressure profile of every body at every output step.
+  std::optional<io::RowFile> contact_csv;
+  if (bodies != nullptr && bodies->has_contact_profile()) {
+    // A checkpoint of a build without the file restarts it (-1: an empty file and its header).
+    const bool kept = resuming && in.checkpoint->has("run/contact_bytes");
+    contact_csv.emplace((out / "contact.csv").string(), kept ? in.checkpoint->integer("run/contact_bytes") : -1);
+    if (!kept) contact_csv->append(contact_csv_header());
+  }
   // runout.csv and deposit.csv (V2 in 2D with rigid bodies, docs/output.md "Run-out measures"):
   // the deposit's front, heights, particle disorder and mass at every output step, and the
   // surface profile of the latest one. The base and the first column are the lowest and the
@@ -297,6 +305,7 @@ int run_loop(const LoopInput& in) {
   };
   auto record_bodies = [&] {
     if (bodies_csv) bodies_csv->append(bodies->csv_rows(solver.time()));
+    if (contact_csv) contact_csv->append(bodies->contact_rows(solver.time()));
     if (runout_csv || particles_csv) {
       const NodeMeasures m = measure_nodes();
       record_runout(m);
@@ -358,6 +367,7 @@ int run_loop(const LoopInput& in) {
     probe_csv.flush();
     energy_csv.flush();
     if (bodies_csv) bodies_csv->flush();
+    if (contact_csv) contact_csv->flush();
     if (runout_csv) runout_csv->flush();
     if (particles_csv) particles_csv->flush();
   };
@@ -384,6 +394,7 @@ int run_loop(const LoopInput& in) {
     a.put_integer("run/probes_bytes", probe_csv.written());
     a.put_integer("run/energy_bytes", energy_csv.written());
     if (bodies_csv) a.put_integer("run/bodies_bytes", bodies_csv->written());
+    if (contact_csv) a.put_integer("run/contact_bytes", contact_csv->written());
     if (runout_csv) a.put_integer("run/runout_bytes", runout_csv->written());
     if (particles_csv) a.put_integer("run/particles_bytes", particles_csv->written());
     save_entries(a, "run/node_frames", node_pvd.entries());

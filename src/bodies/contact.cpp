@@ -337,6 +337,7 @@ void RigidContact::measure(const std::vector<Vec<2>>& x, ConstFieldView<double, 
   // weight on one node alone does not (a footing's pressure jumped by 15-25 % as nodes slid
   // off its edge; docs/VALIDATION.md Case 12).
   power_ = 0.0;
+  profile_.clear();
   std::array<bool, 2> beyond{false, false};
   auto edge = [&](double d, std::size_t end) {
     return d >= 0.0 && (d < dx_ || (beyond[end] && d < adjacent_)) ? d : 0.0;
@@ -392,6 +393,13 @@ void RigidContact::measure(const std::vector<Vec<2>>& x, ConstFieldView<double, 
       force += f;
       width += left + right;
       power -= f.dot(Vec<2>(v(i, 0), v(i, 1)));
+      // The profile carries the traction the reaction integrates (the end lengths' mean
+      // included), so that the sum of its stresses times widths is the body's force.
+      const Vec<2>& n = normal_[slot];
+      const double a = left + right;
+      const Vec<2> te = a > 0.0 ? Vec<2>(f / a) : t;
+      profile_.push_back(
+          {static_cast<int>(b), i, sj, x[static_cast<std::size_t>(i)], n, a, n.dot(te), body_tangent(n).dot(te)});
     }
     state_[b].force = force;
     state_[b].width = width;

@@ -41,6 +41,22 @@ struct BodyState {
   double min_gap = 0.0;  // m: the smallest signed distance of a node before projection (last step)
 };
 
+/// One contact node of a body at the last measure (the contact pressure profile, contact.csv).
+struct ContactPoint {
+  int body = 0;
+  Index node = 0;
+  double s = 0.0;                  // m, its position along the body
+  Vec<2> x = Vec<2>::Zero();       // m
+  Vec<2> normal = Vec<2>::Zero();  // the body's unit normal there, into the soil
+  double width = 0.0;              // m, its tributary length A_I
+  // Pa: n.(sigma n) and t.(sigma n) (t the body's tangent, along increasing s), with sigma n the
+  // traction the reaction integrates (its end lengths take the mean of the patch's last two
+  // nodes), so that the sum of (normal_stress n + shear_stress t) width is the body's force.
+  // Tension positive: the contact pressure is -normal_stress.
+  double normal_stress = 0.0;
+  double shear_stress = 0.0;
+};
+
 class RigidContact {
  public:
   static constexpr int kMaxContacts = 2;
@@ -70,6 +86,8 @@ class RigidContact {
   double power() const { return power_; }
   const std::vector<RigidBody>& bodies() const { return bodies_; }
   const std::vector<BodyState>& state() const { return state_; }
+  /// The contact nodes of every body at the last measure, by body and along it.
+  const std::vector<ContactPoint>& profile() const { return profile_; }
   /// 1 at the nodes in contact (excluded from free-surface detection).
   const std::vector<std::uint8_t>& in_contact() const { return in_contact_; }
   /// Contact slots of node i: body index (or -1), normal, Coulomb slip sign (0: stick).
@@ -109,9 +127,10 @@ class RigidContact {
   std::vector<Vec<2>> normal_;
   std::vector<std::int8_t> slip_, previous_slip_;
   std::vector<std::uint8_t> in_contact_;
-  std::vector<double> release_snn_;                    // per slot of the last step: the normal stress that decides a release
-  std::vector<Vec<2>> x_begin_;                        // positions at t^n (contact nodes only are read)
+  std::vector<double> release_snn_;  // per slot of the last step: the normal stress that decides a release
+  std::vector<Vec<2>> x_begin_;      // positions at t^n (contact nodes only are read)
   std::vector<std::pair<double, std::size_t>> along_;  // (s, node) of one body's contact nodes
+  std::vector<ContactPoint> profile_;                  // every body's contact nodes, last measure
   std::vector<double> last_power_;                     // per body, F.V at the last measure
   double power_ = 0.0;
   bool selected_ = false;

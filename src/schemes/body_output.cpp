@@ -30,4 +30,17 @@ void add_body_report(const std::string& name, const BodyState& st, std::vector<s
   out.emplace_back(name + ".work", st.work);
 }
 
+std::string contact_csv_header() { return "t,body,node,s,x,y,nx,ny,width,normal_stress,shear_stress\n"; }
+
+std::string contact_csv_rows(double t, const std::vector<std::string>& body_names,
+                             const std::vector<ContactPoint>& profile) {
+  std::string rows;
+  for (const ContactPoint& p : profile) {
+    rows += fmt::format("{:.10g},{},{},{:.10g},{:.10g},{:.10g},{:.8g},{:.8g},{:.6g},{:.8g},{:.8g}\n", t,
+                        body_names[static_cast<std::size_t>(p.body)], p.node, p.s, p.x[0], p.x[1], p.normal[0],
+                        p.normal[1], p.width, p.normal_stress, p.shear_stress);
+  }
+  return rows;
+}
+
 }  // namespace rktsph

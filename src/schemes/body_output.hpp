@@ -15,7 +15,15 @@ class BodyOutput {
   virtual ~BodyOutput() = default;
   /// One row per body at time t.
   virtual std::string csv_rows(double t) const = 0;
+  /// contact.csv (V2's contact only): one row per contact node of every body at time t.
+  virtual bool has_contact_profile() const { return false; }
+  virtual std::string contact_rows(double /*t*/) const { return {}; }
 };
+
+/// contact.csv: the header, and the rows of the contact nodes in `profile` at time t.
+std::string contact_csv_header();
+std::string contact_csv_rows(double t, const std::vector<std::string>& body_names,
+                             const std::vector<ContactPoint>& profile);
 
 /// bodies.csv: the header, and the row of body `name` in state `st` at time t.
 std::string body_csv_header();

@@ -276,6 +276,12 @@ std::string ContactEnforce::csv_rows(double t) const {
   return rows;
 }
 
+std::string ContactEnforce::contact_rows(double t) const {
+  std::vector<std::string> names;
+  for (const auto& body : contact_->bodies()) names.push_back(body.spec().name);
+  return contact_csv_rows(t, names, contact_->profile());
+}
+
 template class RebuildOperators<1>;
 template class RebuildOperators<2>;
 template class RebuildOperators<3>;

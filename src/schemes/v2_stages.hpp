@@ -167,6 +167,8 @@ class ContactEnforce final : public Stage, public BodyOutput {
   std::vector<std::pair<std::string, double>> report() const override;
   const RigidContact& contact() const { return *contact_; }
   std::string csv_rows(double t) const override;
+  bool has_contact_profile() const override { return true; }
+  std::string contact_rows(double t) const override;
 
  private:
   StaggeredModel<2>& m_;

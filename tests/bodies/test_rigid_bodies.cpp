@@ -146,6 +146,20 @@ TEST(RigidBodies, SmoothPlateCompressesABlockToTheOedometricSolution) {
   const BodyState& plate = contact.state()[3];
   const double settlement = -plate.offset[1];
   EXPECT_NEAR(settlement, 1.0e-3, 1e-9);
+  // The contact pressure profile (contact.csv) integrates to the plate's reaction: per body,
+  // sum of the normal stress times the width along the normal, and the widths to the width.
+  for (int b = 0; b < 4; ++b) {
+    Vec<2> sum = Vec<2>::Zero();
+    double width = 0.0;
+    for (const ContactPoint& p : contact.profile()) {
+      if (p.body != b) continue;
+      sum += p.width * (p.normal_stress * p.normal + p.shear_stress * body_tangent(p.normal));
+      width += p.width;
+    }
+    const BodyState& st = contact.state()[static_cast<std::size_t>(b)];
+    EXPECT_NEAR(width, st.width, 1e-12) << "body " << b;
+    EXPECT_NEAR((sum - st.force).norm(), 0.0, 1e-9 * std::max(1.0, st.force.norm())) << "body " << b;
+  }
   const double exact = kOedometric * settlement / 1.0 * 1.0;  // N/m: M (delta / H) W
   const double plate_error = std::abs(mean.force - exact) / exact;
   const double base_error = std::abs(-mean.base - exact) / exact;
@@ -366,6 +380,10 @@ TEST(RigidBodies, RunWritesBodiesCsvAndSummary) {
   EXPECT_GT(stage.at("footing.Fy").get<double>(), 0.0);
   EXPECT_EQ(stage.at("footing.contact_nodes").get<double>(), 4.0);
   EXPECT_TRUE(stage.contains("base.node_projections"));
+  // The contact pressure profile: one row per contact node of every body at every output step.
+  const std::string profile = test::read_text(dir.file("out/contact.csv"));
+  EXPECT_EQ(profile.rfind("t,body,node,s,x,y,nx,ny,width,normal_stress,shear_stress\n", 0), 0u);
+  EXPECT_NE(profile.find(",footing,"), std::string::npos);
 }
 
 }  // namespace
