@@ -130,7 +130,8 @@ void detect_free_surface(const ParticleSet<Dim>& set, const Relation<Dim>& relat
       const Vec<Dim> T = xi + h * normal;
       surface = true;
       for (const Index j : relation.row(i)) {
-        if (j == i) continue;
+        // A particle without volume (deactivated outside a domain box) is no material.
+        if (j == i || set.volume[static_cast<std::size_t>(j)] == 0.0) continue;
         const Vec<Dim>& xj = set.position[static_cast<std::size_t>(j)];
         const Vec<Dim> rel = xj - xi;
         const double d2 = rel.squaredNorm();
@@ -193,7 +194,7 @@ void detect_free_surface(const ParticleSet<Dim>& set, const Relation<Dim>& relat
       Vec<Dim> chord[2] = {Vec<Dim>::Zero(), Vec<Dim>::Zero()};
       for (const Index j : relation.row(i)) {
         const auto ju = static_cast<std::size_t>(j);
-        if (j == i) continue;
+        if (j == i || set.volume[ju] == 0.0) continue;
         const bool partner =
             flags[ju] != 0 || (!excluded.empty() && excluded[ju] != 0 && lambda[ju] <= options.interior_above);
         if (!partner) continue;
