@@ -8,6 +8,7 @@
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
 #include <iostream>
 #include <limits>
 #include <optional>
@@ -285,13 +286,19 @@ int run_loop(const LoopInput& in) {
   if constexpr (Dim >= 2) shift_stage = solver.scheme().template find<ShiftNodes<Dim>>();
   const DeactivateOutside<Dim>* deactivate_stage = solver.scheme().template find<DeactivateOutside<Dim>>();
   if (Dim == 2 && setup.version == "v2") {
-    const bool kept = resuming && in.checkpoint->has("run/particles_bytes");
-    particles_csv.emplace((out / "particles.csv").string(), kept ? in.checkpoint->integer("run/particles_bytes") : -1);
-    if (!kept) {
-      particles_csv->append(
-          "t,nn_min,nn_mean,nn_max,nn_cv,clustered,isolated,surface_nodes,mass,stress_points,reseeds,shifts,"
-          "deactivated,deactivated_mass\n");
+    const std::string header =
+        "t,nn_min,nn_mean,nn_max,nn_cv,clustered,isolated,surface_nodes,mass,stress_points,reseeds,shifts,"
+        "deactivated,deactivated_mass";
+    // A checkpoint of a build without the file, or whose file has other columns (an earlier
+    // build's), restarts it: rows of two layouts in one table would be misread.
+    bool kept = resuming && in.checkpoint->has("run/particles_bytes");
+    if (kept) {
+      std::ifstream existing(out / "particles.csv");
+      std::string first;
+      kept = std::getline(existing, first) && first == header;
     }
+    particles_csv.emplace((out / "particles.csv").string(), kept ? in.checkpoint->integer("run/particles_bytes") : -1);
+    if (!kept) particles_csv->append(header + "\n");
   }
   auto record_particles = [&](const NodeMeasures& m) {
     if (!particles_csv) return;

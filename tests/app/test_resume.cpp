@@ -12,6 +12,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -254,6 +255,35 @@ TEST(Resume, V2WithReseededStressPointsResumesBitForBit) {
   interrupt_and_resume(text.c_str(), SIGTERM, 1, 14);
 }
 
+// A run extended from a checkpoint of an earlier build, whose particles.csv had fewer columns,
+// restarts the table with today's header instead of appending longer rows under the old one.
+TEST(Resume, V2ParticlesTableOfAnEarlierLayoutIsRestarted) {
+  test::TempDir dir;
+  const std::string file = dir.write("case.toml", kV2);
+  ASSERT_EQ(wait_status(spawn({RKTSPH_BINARY, "run", file, "--out", dir.file("out"), "-q", "-j", "1"})), 0);
+  const std::string old_header =
+      "t,nn_min,nn_mean,nn_max,nn_cv,clustered,isolated,surface_nodes,mass,stress_points,reseeds,shifts";
+  std::string text = test::read_text(dir.file("out/particles.csv"));
+  text = old_header + text.substr(text.find('\n'));
+  {
+    std::ofstream f(dir.file("out/particles.csv"), std::ios::trunc);
+    f << text;
+  }
+  ASSERT_EQ(wait_status(spawn({RKTSPH_BINARY, "resume", dir.file("out"), "--set", "time.end=1.2", "-q", "-j", "1"})),
+            0);
+  std::istringstream rows(test::read_text(dir.file("out/particles.csv")));
+  std::string line;
+  std::getline(rows, line);
+  EXPECT_NE(line, old_header);
+  EXPECT_EQ(line.rfind(old_header + ",deactivated,deactivated_mass", 0), 0u);
+  int count = 0;
+  while (std::getline(rows, line)) {
+    ++count;
+    EXPECT_EQ(std::count(line.begin(), line.end(), ','), 13) << line;
+  }
+  EXPECT_GE(count, 1);
+}
+
 // particles.csv: the disorder, the mass and the regularisations at every output step (V2, 2D).
 TEST(Resume, V2ParticlesTableCountsTheReseedings) {
   std::string text = kV2;
@@ -265,8 +295,9 @@ TEST(Resume, V2ParticlesTableCountsTheReseedings) {
   std::istringstream rows(test::read_text(dir.file("out/particles.csv")));
   std::string line, last;
   std::getline(rows, line);
-  EXPECT_EQ(line, "t,nn_min,nn_mean,nn_max,nn_cv,clustered,isolated,surface_nodes,mass,stress_points,reseeds,shifts,"
-                  "deactivated,deactivated_mass");
+  EXPECT_EQ(line,
+            "t,nn_min,nn_mean,nn_max,nn_cv,clustered,isolated,surface_nodes,mass,stress_points,reseeds,shifts,"
+            "deactivated,deactivated_mass");
   int count = 0;
   while (std::getline(rows, line)) last = line, ++count;
   EXPECT_EQ(count, 21);  // t = 0 and every 0.05 s to 1 s
