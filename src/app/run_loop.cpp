@@ -148,15 +148,22 @@ int run_loop(const LoopInput& in) {
   // which in large deformation have moved by the time of a checkpoint.
   if (resuming) solver.load_state(*in.checkpoint);
 
-  const double dt = solver.dt();
+  // The steps of a fixed step; with the step from the current state (time.dt_rule = "current",
+  // method-notes eq. (4.3.3)) the run ends on the clock and this is the initial step's estimate.
+  const bool adaptive = setup.dt_from_current_state;
+  const double dt = solver.clock().initial_dt();
   const long total_steps = static_cast<long>(std::ceil(setup.end_time / dt - 1e-9));
+  const double end_tolerance = 1e-12 * setup.end_time;
+  auto at_end = [&](long steps) {
+    return adaptive ? solver.time() >= setup.end_time - end_tolerance : steps >= total_steps;
+  };
   const double checkpoint_every = setup.checkpoint_interval.value_or(setup.end_time / 10.0);
   LoopState loop;
-  if (resuming && solver.step_count() > total_steps) {
+  if (resuming && (adaptive ? solver.time() > setup.end_time + end_tolerance : solver.step_count() > total_steps)) {
     throw InputError(fmt::format("{}: the checkpoint is at t = {:.6g} s (step {}), past time.end = {:.6g} s",
                                  out.string(), solver.time(), solver.step_count(), setup.end_time));
   }
-  if (resuming && solver.step_count() == total_steps) {
+  if (resuming && at_end(solver.step_count())) {
     if (!opt.quiet) {
       std::cerr << fmt::format("{}: the run is complete (t = {:.6g} s); extend it with --set time.end=...\n",
                                out.string(), solver.time());
@@ -435,7 +442,11 @@ int run_loop(const LoopInput& in) {
         {"spacing", setup.dx},
         {"smoothing_length", setup.h_over_dx * setup.dx},
         {"max_wave_speed", solver.max_wave_speed()},
-        {"dt", dt},
+        {"dt", solver.dt()},
+        {"dt_rule", adaptive ? "current" : "fixed"},
+        {"dt_initial", dt},
+        {"dt_min", solver.clock().dt_min()},
+        {"dt_max", solver.clock().dt_max()},
         {"cfl", solver.cfl()},
         {"steps", solver.step_count()},
         {"steps_planned", total_steps},
@@ -504,15 +515,19 @@ int run_loop(const LoopInput& in) {
   if (!opt.quiet) {
     if (resuming) {
       std::cerr << fmt::format(
-          "rktsph {}: resuming {} at step {} of {} (t = {:.6g} s), {} thread{}{}, wait policy {}\n", kVersion,
-          out.string(), solver.step_count(), total_steps, solver.time(), threads, threads > 1 ? "s" : "",
-          exec::adaptive_teams() ? " (adaptive)" : "", wait_policy);
+          "rktsph {}: resuming {} at step {} {} (t = {:.6g} s), {} thread{}{}, wait policy {}\n", kVersion,
+          out.string(), solver.step_count(),
+          adaptive ? fmt::format("(dt = {:.4g} s from the current state)", solver.dt())
+                   : fmt::format("of {}", total_steps),
+          solver.time(), threads, threads > 1 ? "s" : "", exec::adaptive_teams() ? " (adaptive)" : "", wait_policy);
     } else {
       std::cerr << fmt::format(
-          "rktsph {}: {} ({}D, {} nodes, {} stress points, dt = {:.4g} s, C = {:.3f}, {} steps, {} thread{}{}, "
+          "rktsph {}: {} ({}D, {} nodes, {} stress points, dt = {:.4g} s{}, C = {:.3f}, {} steps{}, {} thread{}{}, "
           "wait policy {})\n",
-          kVersion, opt.case_file, Dim, solver.nodes().size(), solver.stress_points().size(), dt, solver.cfl(),
-          total_steps, threads, threads > 1 ? "s" : "", exec::adaptive_teams() ? " (adaptive)" : "", wait_policy);
+          kVersion, opt.case_file, Dim, solver.nodes().size(), solver.stress_points().size(), dt,
+          adaptive ? " at the start, then from the current state" : "", solver.cfl(), total_steps,
+          adaptive ? " if it stays" : "", threads, threads > 1 ? "s" : "", exec::adaptive_teams() ? " (adaptive)" : "",
+          wait_policy);
     }
     if (pressure != nullptr && pressure->implicit_faces()) {
       std::cerr << fmt::format(
@@ -554,9 +569,10 @@ int run_loop(const LoopInput& in) {
     }
     auto last_progress = t_loop;
     const long first = solver.step_count();
+    const double t_first = solver.time();
     // Moving particles (V2) can lose their neighbours: say so once, when it first happens.
     Index degenerate_seen = solver.degenerate_operator_rows();
-    for (long n = first; n < total_steps; ++n) {
+    for (long n = first; !at_end(n); ++n) {
       solver.step();
       if (solver.degenerate_operator_rows() > degenerate_seen) {
         degenerate_seen = std::numeric_limits<Index>::max();
@@ -565,7 +581,7 @@ int run_loop(const LoopInput& in) {
             "plain SPH sums: the body is separating (gaps) or thinning below the kernel's support there\n",
             solver.time(), solver.degenerate_operator_rows());
       }
-      const bool last = n + 1 == total_steps;
+      const bool last = at_end(n + 1);
       if ((n + 1) % setup.probe_every == 0 || last) record_probes();
       if ((n + 1) % loop.energy_every == 0 || last) record_energy();
       bool output = last;
@@ -606,9 +622,13 @@ int run_loop(const LoopInput& in) {
         if (std::chrono::duration<double>(now - last_progress).count() > 0.5 || last) {
           last_progress = now;
           const double elapsed = std::chrono::duration<double>(now - t_loop).count();
-          const double eta = elapsed * static_cast<double>(total_steps - n - 1) / static_cast<double>(n + 1 - first);
-          std::cerr << fmt::format("\r  t = {:.5g} s of {:.5g} s ({:3.0f} %), step {} of {}, ETA {}   ", t,
-                                   setup.end_time, 100.0 * t / setup.end_time, n + 1, total_steps, duration_text(eta))
+          const double eta =
+              adaptive ? elapsed * (setup.end_time - t) / std::max(t - t_first, 1e-300)
+                       : elapsed * static_cast<double>(total_steps - n - 1) / static_cast<double>(n + 1 - first);
+          const std::string of_steps = adaptive ? fmt::format("dt = {:.4g} s", solver.dt())
+                                                : fmt::format("of {}", total_steps);
+          std::cerr << fmt::format("\r  t = {:.5g} s of {:.5g} s ({:3.0f} %), step {} {}, ETA {}   ", t,
+                                   setup.end_time, 100.0 * t / setup.end_time, n + 1, of_steps, duration_text(eta))
                     << std::flush;
         }
       }
@@ -672,6 +692,10 @@ int run_loop(const LoopInput& in) {
       std::cerr << fmt::format("free surface: {:.0f} nodes at the last step; detection {:.3g} s ({:.0f} %)\n",
                                figure(surface, "surface_nodes_last_step"), figure(surface, "detection_seconds"),
                                share(figure(surface, "detection_seconds")));
+    }
+    if (adaptive) {
+      std::cerr << fmt::format("time step from the current state: {:.4g} to {:.4g} s (initial {:.4g} s)\n",
+                               solver.clock().dt_min(), solver.clock().dt_max(), dt);
     }
     if (deactivate_stage != nullptr && deactivate_stage->deactivated() > 0) {
       std::cerr << fmt::format(

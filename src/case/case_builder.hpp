@@ -141,6 +141,12 @@ class CaseBuilder {
     c_.dt.reset();
     return *this;
   }
+  /// time.dt_rule = "current" (V2): the step from the current state every step, at the
+  /// Courant number of time() (method-notes eq. (4.3.3)).
+  CaseBuilder& step_from_current_state() {
+    c_.dt_from_current_state = true;
+    return *this;
+  }
   /// End time and a fixed step.
   CaseBuilder& time_step(double end, double dt) {
     c_.end_time = end;
@@ -195,6 +201,8 @@ class CaseBuilder {
     if (c.detect_free_surface && (c.version != "v2" || Dim < 2))
       fail("free-surface detection needs the V2 scheme in 2D or 3D");
     if (c.domain_box && c.version != "v2") fail("a domain box needs the V2 scheme");
+    if (c.dt_from_current_state && (c.version != "v2" || c.dt))
+      fail("a step from the current state needs the V2 scheme and a Courant number, not a fixed step");
     if (!(c.dx > 0.0)) fail("the spacing must be > 0");
     if (!(c.jitter.fraction >= 0.0 && c.jitter.fraction < kMaxJitterFraction))
       fail(fmt::format("the jitter must lie in [0, {}) spacings", kMaxJitterFraction));

@@ -514,6 +514,18 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
                          "m); the scheme is unstable beyond it (method-notes §0.3 item 4)",
                          step.courant, kMaxCourant, step.wave_speed, c.dx));
     }
+    // V2: the step from the current state (method-notes §4.3, eq. (4.3.3)).
+    const std::string rule = t.string("dt_rule", "fixed");
+    if (rule == "current") {
+      t.require(c.version == "v2", "dt_rule",
+                fmt::format("\"current\" follows moving particles and needs solver.version = \"v2\" (this case is "
+                            "\"{}\"; its particles do not move, so its step is fixed)",
+                            c.version));
+      t.require(!has_dt, "dt_rule", "\"current\" sets the step from time.cfl: give time.cfl, not time.dt");
+      c.dt_from_current_state = true;
+    } else if (rule != "fixed") {
+      t.fail("dt_rule", fmt::format("unknown rule '{}' (\"fixed\" or \"current\")", rule));
+    }
     // Size guard: the number of steps, before the run (case/size_limits.hpp).
     c.max_steps = t.number("max_steps", kDefaultMaxSteps);
     t.require(c.max_steps >= 1.0 && c.max_steps <= kMaxStepsCeiling, "max_steps",

@@ -223,6 +223,10 @@ struct CaseSetup {
   double end_time = 0.0;
   std::optional<double> cfl;
   std::optional<double> dt;
+  /// time.dt_rule = "current" (V2): the step recomputed every step from the current density,
+  /// dt^n = C dx / max_i c_i(rho_i^n) (method-notes eq. (4.3.3)); false: fixed (time.dt or
+  /// C dx / c on the initial state).
+  bool dt_from_current_state = false;
   /// time.max_steps: the run is refused before it starts if end_time / dt exceeds it
   /// (case/size_limits.hpp).
   double max_steps = kDefaultMaxSteps;

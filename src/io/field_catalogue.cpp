@@ -69,6 +69,12 @@ FieldCatalogue<Dim>::FieldCatalogue(const Simulation<Dim>& sim, Set set) {
       }
     }
   }
+  // V2: the density of the continuity equation (kg/m^3), which the step from the current state
+  // follows (method-notes eq. (4.3.3)); constant in the schemes whose particles do not move.
+  if (sim.setup().version == "v2") {
+    const std::vector<double>* density = &particles.density;
+    scalar("density", [density](Index i) { return (*density)[static_cast<std::size_t>(i)]; });
+  }
   const std::vector<int>* material = &particles.material;
   fields_.push_back({"material", 1, [material](Index i, int) { return (*material)[static_cast<std::size_t>(i)]; }});
 }

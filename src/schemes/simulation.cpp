@@ -50,6 +50,7 @@ void Simulation<Dim>::step() {
     const EnergyBalance e0 = energy();
     clock_.set_initial_energy(e0.kinetic + std::abs(e0.strain));
   }
+  if (model_->setup.dt_from_current_state) choose_step(t);
   StepContext context;
   context.t = t;
   context.dt = clock_.dt();
@@ -78,6 +79,26 @@ void Simulation<Dim>::step() {
         clock_.steps() + 1, t + clock_.dt(), bad, fmt::join(x.data(), x.data() + Dim, ", "), clock_.courant()));
   }
   clock_.end_step(sums, external_power(), scheme_->instability_hint ? scheme_->instability_hint() : std::string());
+}
+
+template <int Dim>
+void Simulation<Dim>::choose_step(double t) {
+  // eq. (4.3.3): the case's Courant number over the fastest wave of the current state, on the
+  // initial spacing (the smoothing length is fixed; method-notes §4.3 says why the particle
+  // spacing does not enter), and the last step cut to end on time.end.
+  double stretch = 0.0;
+  const double c = model_->current_wave_speed(&stretch);
+  const double rule_dt = clock_.courant() * model_->dx() / c;
+  double dt = rule_dt;
+  const double end = model_->setup.end_time;
+  if (t + dt >= end - 1e-12 * end) dt = std::max(end - t, 0.0);
+  if (rule_dt < kSmallestStepRatio * clock_.initial_dt()) {
+    throw SolverError(fmt::format(
+        "the time step from the current state fell to {:.3g} s at t = {:.6g} s, {:.2g} of the initial {:.3g} s: a "
+        "particle's density is {:.3g} times below its material's (c = {:.4g} m/s); the body is tearing apart",
+        rule_dt, t, rule_dt / clock_.initial_dt(), clock_.initial_dt(), stretch, c));
+  }
+  clock_.set_dt(dt, rule_dt);
 }
 
 template <int Dim>

@@ -111,6 +111,10 @@ class Simulation {
   void load_state(const io::StateArchive& archive);
 
  private:
+  /// time.dt_rule = "current": the length of the step from t (method-notes eq. (4.3.3)).
+  void choose_step(double t);
+  /// A step from the current state this far below the initial one stops the run.
+  static constexpr double kSmallestStepRatio = 1e-3;
   StepSums<Dim> balance_sums();
   /// The power of the loads: the boundary tractions and the scheme's extra power (bodies).
   double external_power();

@@ -64,6 +64,8 @@ StaggeredModel<Dim>::StaggeredModel(CaseSetup<Dim> case_setup, exec::Threads thr
   for (const auto& m : materials.models) {
     densities.push_back(m->density());
     materials.elastic.push_back(m->elastic_rate());
+    materials.p_modulus.push_back(m->wave_speed() * m->wave_speed() * m->density());
+    materials.density.push_back(m->density());
     materials.any_source = materials.any_source || m->has_source();
   }
   materials.history = HistoryLayout(materials.models);
@@ -205,6 +207,24 @@ StaggeredModel<Dim>::StaggeredModel(CaseSetup<Dim> case_setup, exec::Threads thr
       surface.traction_function = constraints.rotated_functions();
     }
   }
+}
+
+template <int Dim>
+double StaggeredModel<Dim>::current_wave_speed(double* stretch) const {
+  // c_i^2 = M_m / rho_i: the constrained modulus of every material here is constant, so the
+  // speed follows the density alone (eq. (4.3.3)).
+  const std::vector<double>& modulus = materials.p_modulus;
+  double c2 = 0.0, ratio = 0.0;
+  for (const ParticleSet<Dim>* set : {&nodes, &stress_points}) {
+    for (std::size_t i = 0; i < set->density.size(); ++i) {
+      if (set->volume[i] <= 0.0) continue;
+      const auto m = static_cast<std::size_t>(set->material[i]);
+      c2 = std::max(c2, modulus[m] / set->density[i]);
+      ratio = std::max(ratio, materials.density[m] / set->density[i]);
+    }
+  }
+  if (stretch != nullptr) *stretch = ratio;
+  return std::sqrt(c2);
 }
 
 template <int Dim>

@@ -46,6 +46,8 @@ struct StaggeredFields {
 struct MaterialTable {
   std::vector<std::shared_ptr<const Material>> models;
   std::vector<ElasticRate> elastic;  // per material
+  std::vector<double> p_modulus;     // per material: rho c^2 of its fastest wave, Pa
+  std::vector<double> density;       // per material: its reference density, kg/m^3
   HistoryLayout history;
   bool any_source = false;
   const Material& operator[](int m) const { return *models[static_cast<std::size_t>(m)]; }
@@ -131,6 +133,11 @@ class StaggeredModel {
   /// Power of the surface tractions on the body, W (per unit thickness in 2D): the sum over
   /// face nodes of A (sigma . n) . v, with the total stress.
   double boundary_power() const;
+
+  /// The fastest P-wave over both particle sets at their current densities, m/s:
+  /// max c_m (rho_m / rho_i)^(1/2) (method-notes eq. (4.3.3); particles without volume, frozen
+  /// outside the domain box, do not count). The largest ratio is returned in `stretch`.
+  double current_wave_speed(double* stretch = nullptr) const;
 
   /// Initial velocity, stress and history (method-notes §4.2), then the constraints at t = 0.
   void set_initial_state();

@@ -64,6 +64,9 @@ void TimeControl<Dim>::save(io::StateArchive& a) const {
   a.put("clock/time", time_);
   a.put_integer("clock/steps", steps_);
   a.put("clock/dt", step_.dt);
+  a.put("clock/dt_initial", initial_dt_);
+  a.put("clock/dt_min", dt_min_);
+  a.put("clock/dt_max", dt_max_);
   a.put("clock/external_work", external_work_);
   a.put("clock/damping_loss", damping_loss_);
   a.put("clock/initial_strain", initial_strain_);
@@ -77,10 +80,21 @@ void TimeControl<Dim>::save(io::StateArchive& a) const {
 
 template <int Dim>
 void TimeControl<Dim>::load(const io::StateArchive& a) {
-  if (a.number("clock/dt") != step_.dt) {
+  // The case's step (a checkpoint of a build before time.dt_rule holds only the fixed one).
+  const double saved_initial = a.has("clock/dt_initial") ? a.number("clock/dt_initial") : a.number("clock/dt");
+  if (saved_initial != initial_dt_) {
     throw InputError(fmt::format("the checkpoint's time step ({:.17g} s) is not this case's ({:.17g} s): the case "
                                  "changed since it was written",
-                                 a.number("clock/dt"), step_.dt));
+                                 saved_initial, initial_dt_));
+  }
+  if (setup_.dt_from_current_state) {
+    step_.dt = a.number("clock/dt");
+    dt_min_ = a.has("clock/dt_min") ? a.number("clock/dt_min") : step_.dt;
+    dt_max_ = a.has("clock/dt_max") ? a.number("clock/dt_max") : step_.dt;
+  } else if (a.number("clock/dt") != initial_dt_) {
+    throw InputError(
+        "the checkpoint was written with a step from the current state (time.dt_rule = \"current\"), this case "
+        "has a fixed step: give time.dt_rule = \"current\" to resume it");
   }
   time_ = a.number("clock/time");
   steps_ = static_cast<long>(a.integer("clock/steps"));

@@ -2,6 +2,7 @@
 // The time-control room of a run (docs/architecture.md): the clock and the step, the damping
 // schedule (method-notes §4.2), the energy account and the growth guard that stops an unstable
 // run while its state is still finite.
+#include <algorithm>
 #include <array>
 #include <limits>
 #include <string>
@@ -30,13 +31,27 @@ using StepSums = std::array<double, Dim + 2>;
 template <int Dim>
 class TimeControl {
  public:
-  TimeControl(const CaseSetup<Dim>& setup, const TimeStep& step) : setup_(setup), step_(step) {}
+  TimeControl(const CaseSetup<Dim>& setup, const TimeStep& step)
+      : setup_(setup), step_(step), initial_dt_(step.dt), dt_min_(step.dt), dt_max_(step.dt) {}
 
   double time() const { return time_; }
   double dt() const { return step_.dt; }
   double courant() const { return step_.courant; }
   double wave_speed() const { return step_.wave_speed; }
   long steps() const { return steps_; }
+  /// The step of the case's initial state (time.dt, or C dx / c), s.
+  double initial_dt() const { return initial_dt_; }
+  /// The shortest and the longest step the rule has given so far (time.dt_rule = "current";
+  /// the last step, cut to end on time.end, not counted), s.
+  double dt_min() const { return dt_min_; }
+  double dt_max() const { return dt_max_; }
+  /// The length of the next step (time.dt_rule = "current": set before each step), and the
+  /// rule's step before the cut to time.end.
+  void set_dt(double dt, double rule_dt) {
+    step_.dt = dt;
+    dt_min_ = std::min(dt_min_, rule_dt);
+    dt_max_ = std::max(dt_max_, rule_dt);
+  }
 
   /// Damping coefficient in force at time t: c_d before damping.until and before the
   /// kinetic-energy switch (damping.until_kinetic_ratio) has fired, else 0.
@@ -70,6 +85,7 @@ class TimeControl {
  private:
   const CaseSetup<Dim>& setup_;
   TimeStep step_;
+  double initial_dt_, dt_min_, dt_max_;
   double time_ = 0.0;
   long steps_ = 0;
   double external_work_ = 0.0, damping_loss_ = 0.0, initial_strain_ = 0.0;

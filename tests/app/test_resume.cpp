@@ -255,6 +255,15 @@ TEST(Resume, V2WithReseededStressPointsResumesBitForBit) {
   interrupt_and_resume(text.c_str(), SIGTERM, 1, 14);
 }
 
+// With the step from the current state (time.dt_rule = "current") the checkpoint carries the
+// step, which the resumed run continues from.
+TEST(Resume, V2WithTheStepFromTheCurrentStateResumesBitForBit) {
+  std::string text = kV2;
+  const std::string key = "cfl = 0.5";
+  text.replace(text.find(key), key.size(), key + "\ndt_rule = \"current\"");
+  interrupt_and_resume(text.c_str(), SIGTERM, 1, 15);
+}
+
 // A run extended from a checkpoint of an earlier build, whose particles.csv had fewer columns,
 // restarts the table with today's header instead of appending longer rows under the old one.
 TEST(Resume, V2ParticlesTableOfAnEarlierLayoutIsRestarted) {

@@ -228,6 +228,28 @@ TEST(InputErrors, DomainBoxThatCutsTheBody) {
   EXPECT_NE(o.err.find("outside the domain box"), std::string::npos) << o.err;
 }
 
+TEST(InputErrors, StepFromTheCurrentStateNeedsV2) {
+  test::TempDir dir;
+  const std::string text = replace(kBase, "cfl = 0.5", "cfl = 0.5\ndt_rule = \"current\"");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "dt_rule"), "time.dt_rule", {"v2"});
+}
+
+TEST(InputErrors, StepFromTheCurrentStateWithAFixedStep) {
+  test::TempDir dir;
+  const std::string text = replace(replace(kBase, "cfl = 0.5", "dt = 1e-5\ndt_rule = \"current\""), "[time]",
+                                   "[solver]\nversion = \"v2\"\n[time]");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "dt_rule"), "time.dt_rule", {"time.cfl"});
+}
+
+TEST(InputErrors, UnknownStepRule) {
+  test::TempDir dir;
+  const std::string text = replace(kBase, "cfl = 0.5", "cfl = 0.5\ndt_rule = \"adaptive\"");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "dt_rule"), "time.dt_rule", {"adaptive", "current"});
+}
+
 TEST(InputErrors, PressureFilterOutOfRange) {
   test::TempDir dir;
   const std::string text = replace(kBase, "[time]", "[solver]\npressure_filter = -1.0\n[time]");
