@@ -232,7 +232,20 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     if (std::find(known.begin(), known.end(), c.version) == known.end()) {
       s->fail("version", fmt::format("unknown solver version '{}' (available: {})", c.version, fmt::join(known, ", ")));
     }
-    // V3 pressure solve (method-notes §2.4 "Solver"); read for every version, used by v3 only.
+    // V3 pressure solve (method-notes §2.4 "Solver"): its keys in a dry scheme are an error, not
+    // silently dropped (a case moved from V3 to V2 keeps no pressure option it seems to have).
+    if (!find_scheme<Dim>(c.version)->pore_fluid) {
+      for (const char* key : {"pressure_preconditioner", "pressure_tolerance", "pressure_max_iterations",
+                              "pressure_deferred_correction", "pressure_divergence", "pressure_incremental",
+                              "pressure_faces", "pressure_filter", "pressure_filter_gradient",
+                              "pressure_odd_even_filter"}) {
+        if (s->has(key)) {
+          s->fail(key, fmt::format("a key of the pore-pressure solve, for solver.version = \"v3\"; this case is "
+                                   "\"{}\" (dry): remove it",
+                                   c.version));
+        }
+      }
+    }
     const std::string pc = s->string("pressure_preconditioner", "jacobi");
     if (pc == "jacobi")
       c.fluid.incomplete_cholesky = false;

@@ -129,7 +129,7 @@ TEST(InputErrors, WrongType) {
 
 TEST(InputErrors, UnknownPressureDivergence) {
   test::TempDir dir;
-  const std::string text = replace(kBase, "[time]", "[solver]\npressure_divergence = \"elements\"\n[time]");
+  const std::string text = replace(kBase, "[time]", "[fluid]\nporosity = 0.3\ndensity = 1000.0\nbulk_modulus = 2.2e9\nconductivity = 1.0e-5\n[solver]\nversion = \"v3\"\npressure_divergence = \"elements\"\n[time]");
   const auto o = run_case_text(dir, text);
   expect_error_at(o, line_of(text, "pressure_divergence"), "solver.pressure_divergence", {"nodes", "stress_points"});
 }
@@ -137,7 +137,7 @@ TEST(InputErrors, UnknownPressureDivergence) {
 TEST(InputErrors, IncrementalProjectionWithStressPointDivergence) {
   test::TempDir dir;
   const std::string text = replace(
-      kBase, "[time]", "[solver]\npressure_divergence = \"stress_points\"\npressure_incremental = true\n[time]");
+      kBase, "[time]", "[fluid]\nporosity = 0.3\ndensity = 1000.0\nbulk_modulus = 2.2e9\nconductivity = 1.0e-5\n[solver]\nversion = \"v3\"\npressure_divergence = \"stress_points\"\npressure_incremental = true\n[time]");
   const auto o = run_case_text(dir, text);
   expect_error_at(o, line_of(text, "pressure_incremental"), "solver.pressure_incremental", {"unstable"});
 }
@@ -250,16 +250,39 @@ TEST(InputErrors, UnknownStepRule) {
   expect_error_at(o, line_of(text, "dt_rule"), "time.dt_rule", {"adaptive", "current"});
 }
 
+// A V2 case with the keys of V3: the [fluid] table, a pore-pressure condition, a pressure-solve
+// option; each named at its line, none silently dropped.
+TEST(InputErrors, V2CaseWithV3Keys) {
+  const std::string v2 = replace(kBase, "[time]", "[solver]\nversion = \"v2\"\n[time]");
+  {
+    test::TempDir dir;
+    const std::string text = replace(v2, "[solver]", "[solver]\npressure_faces = \"implicit\"");
+    expect_error_at(run_case_text(dir, text), line_of(text, "pressure_faces"), "solver.pressure_faces", {"v3"});
+  }
+  {
+    test::TempDir dir;
+    const std::string text = replace(v2, "[time]", "[fluid]\nporosity = 0.3\nbulk_modulus = 2.2e9\n[time]");
+    expect_error_at(run_case_text(dir, text), line_of(text, "porosity"), "fluid.porosity", {"v3"});
+  }
+  {
+    test::TempDir dir;
+    const std::string text = replace(v2, "name = \"base\"", "name = \"base\"\nimpermeable = true");
+    const auto o = run_case_text(dir, text);
+    EXPECT_NE(o.status, 0);
+    EXPECT_NE(o.err.find("v3"), std::string::npos) << o.err;
+  }
+}
+
 TEST(InputErrors, PressureFilterOutOfRange) {
   test::TempDir dir;
-  const std::string text = replace(kBase, "[time]", "[solver]\npressure_filter = -1.0\n[time]");
+  const std::string text = replace(kBase, "[time]", "[fluid]\nporosity = 0.3\ndensity = 1000.0\nbulk_modulus = 2.2e9\nconductivity = 1.0e-5\n[solver]\nversion = \"v3\"\npressure_filter = -1.0\n[time]");
   const auto o = run_case_text(dir, text);
   expect_error_at(o, line_of(text, "pressure_filter"), "solver.pressure_filter", {"[0, 10]"});
 }
 
 TEST(InputErrors, UnknownPressureFilterGradient) {
   test::TempDir dir;
-  const std::string text = replace(kBase, "[time]", "[solver]\npressure_filter_gradient = \"cubic\"\n[time]");
+  const std::string text = replace(kBase, "[time]", "[fluid]\nporosity = 0.3\ndensity = 1000.0\nbulk_modulus = 2.2e9\nconductivity = 1.0e-5\n[solver]\nversion = \"v3\"\npressure_filter_gradient = \"cubic\"\n[time]");
   const auto o = run_case_text(dir, text);
   expect_error_at(o, line_of(text, "pressure_filter_gradient"), "solver.pressure_filter_gradient",
                   {"quadratic_drained", "quadratic", "linear"});
@@ -267,7 +290,7 @@ TEST(InputErrors, UnknownPressureFilterGradient) {
 
 TEST(InputErrors, OddEvenFilterOutOfRange) {
   test::TempDir dir;
-  const std::string text = replace(kBase, "[time]", "[solver]\npressure_odd_even_filter = 1.5\n[time]");
+  const std::string text = replace(kBase, "[time]", "[fluid]\nporosity = 0.3\ndensity = 1000.0\nbulk_modulus = 2.2e9\nconductivity = 1.0e-5\n[solver]\nversion = \"v3\"\npressure_odd_even_filter = 1.5\n[time]");
   const auto o = run_case_text(dir, text);
   expect_error_at(o, line_of(text, "pressure_odd_even_filter"), "solver.pressure_odd_even_filter", {"[0, 1]"});
 }
@@ -548,7 +571,7 @@ TEST(InputErrors, IntegersBeyondTheirRange) {
   }
   {
     const std::string text =
-        replace(kBase, "[time]", "[solver]\npressure_max_iterations = 9223372036854775807\n[time]");
+        replace(kBase, "[time]", "[fluid]\nporosity = 0.3\ndensity = 1000.0\nbulk_modulus = 2.2e9\nconductivity = 1.0e-5\n[solver]\nversion = \"v3\"\npressure_max_iterations = 9223372036854775807\n[time]");
     const auto o = run_case_text(dir, text);
     expect_error_at(o, line_of(text, "pressure_max_iterations"), "solver.pressure_max_iterations", {"2147483647"});
   }
