@@ -76,6 +76,9 @@ def main():
     ap.add_argument("--low", type=float, default=-0.03, help="lower tolerance on the error (default -0.03)")
     ap.add_argument("--high", type=float, default=0.08, help="upper tolerance on the error (default +0.08)")
     ap.add_argument("--no-plot", action="store_true")
+    ap.add_argument("--hold", type=float, metavar="T",
+                    help="stop the footing at T s (over 0.1 s) and hold it to time.end: reports the pressure "
+                         "just before the stop and its decay while held (a rate-independent soil keeps it)")
     args = ap.parse_args()
 
     with open(args.case, "rb") as f:
@@ -114,6 +117,16 @@ def main():
     if not args.no_run:
         cut = text.find(MARKER)
         base = text if cut < 0 else text[:cut]
+        if args.hold is not None:
+            # The footing's ramp becomes ramp - hold - stop: a table with the same rise.
+            start = base.index("[functions.push]")
+            stop = base.index("\n[", start + 1)
+            rise = float(case["functions"]["push"]["duration"])
+            if not rise < args.hold:
+                sys.exit(f"check_footing_cphi: --hold {args.hold} s must come after the {rise} s ramp")
+            base = (base[:start] + "[functions.push]\ntype = \"table\"\n"
+                    f"times = [0.0, {rise}, {args.hold}, {args.hold + 0.1}]\nvalues = [0.0, 1.0, 1.0, 0.0]\n"
+                    + base[stop:])
         probes = "".join(
             f'\n[[probe]]\nname = "p{i:02d}"\nposition = [{i * dx:.6f}, {top}]\nfields = ["uy", "syy"]\n'
             for i in range(n_nodes))
@@ -149,6 +162,16 @@ def main():
         settle.append(-float(r["centre.uy"]))
         press.append(force / b)
         press_nodes.append(force_nodes / b)
+    if args.hold is not None:
+        times = [float(r["t"]) for r in rows]
+        def mean_q(t0, t1):
+            qs = [q for t, q in zip(times, press) if t0 <= t <= t1]
+            return sum(qs) / len(qs) if qs else float("nan")
+        moving = mean_q(args.hold - 0.2, args.hold)
+        print(f"hold at {args.hold:g} s: q moving (mean over the last 0.2 s) = {moving / q_u:.4f} q_u; held: "
+              f"{mean_q(args.hold + 0.4, args.hold + 0.6) / q_u:.4f} q_u after 0.5 s, "
+              f"{press[-1] / q_u:.4f} q_u at {times[-1]:g} s")
+        sys.exit(0)
     s_end = settle[-1]
     window = [(s, q) for s, q in zip(settle, press) if s >= 0.75 * s_end]
     plateau = sum(q for _, q in window) / len(window)
