@@ -60,9 +60,7 @@ StaggeredModel<Dim>::StaggeredModel(CaseSetup<Dim> case_setup, exec::Threads thr
   };
   if (auto p = lattice_size_problem(setup)) throw size_error(*p);
   materials.models = setup.materials;
-  std::vector<double> densities;
   for (const auto& m : materials.models) {
-    densities.push_back(m->density());
     materials.elastic.push_back(m->elastic_rate());
     materials.p_modulus.push_back(m->wave_speed() * m->wave_speed() * m->density());
     materials.density.push_back(m->density());
@@ -85,7 +83,7 @@ StaggeredModel<Dim>::StaggeredModel(CaseSetup<Dim> case_setup, exec::Threads thr
     lat.stress_points = setup.imported->stress_points;
     lat.boundary = setup.imported->boundary;
   } else {
-    lat = generate_lattice<Dim>(setup.blocks, setup.dx, setup.origin, densities, setup.jitter);
+    lat = generate_lattice<Dim>(setup.blocks, setup.dx, setup.origin, materials.density, setup.jitter);
   }
   {
     // The memory estimate with the exact particle counts, before fields and operators.

@@ -165,8 +165,10 @@ CaseReport validate_case07(const Options& opt, const std::string& dir) {
   for (const auto& [dx, rule] : runs) {
     const bool fixed = rule == "fixed";
     const std::string tag = fmt::format("dx{}{}", dx, fixed ? "" : "_current_dt");
-    // The rows' prefix: "push, dx = 0.05" (and ", dt_rule current").
-    const std::string with = fixed ? "" : ", dt_rule current";
+    // A row's name: "push, dx = 0.05: what" (", dt_rule current" before the colon).
+    auto row = [&, dx = dx](const char* load, const std::string& what) {
+      return fmt::format("{}, dx = {}{}: {}", load, dx, fixed ? "" : ", dt_rule current", what);
+    };
     // ---- push: one shock
     const BarRun p = run_bar(case_file, dx, kV0, "v2", "simple", rule);
     write_profiles(fmt::format("{}/push_{}.csv", dir, tag), p);
@@ -193,17 +195,17 @@ CaseReport validate_case07(const Options& opt, const std::string& dir) {
       worst_sigma = std::max(worst_sigma, std::abs(sig / count / sigma_push - 1.0));
       worst_overshoot = std::max(worst_overshoot, smin / sigma_push - 1.0);
     }
-    rep.metrics.push_back(metric(fmt::format("push, dx = {}{}: shock position error at 0.06 / 0.12 s (max)", dx, with),
+    rep.metrics.push_back(metric(row("push", "shock position error at 0.06 / 0.12 s (max)"),
                                  worst_front, "<=", 2.0, "dx"));
     rep.metrics.push_back(
-        metric(fmt::format("push, dx = {}{}: plateau lambda error", dx, with), worst_lambda, "<=", 0.02, ""));
-    rep.metrics.push_back(metric(fmt::format("push, dx = {}{}: plateau sigma error", dx, with), worst_sigma, "<=", 0.02, ""));
-    rep.metrics.push_back(metric(fmt::format("push, dx = {}{}: overshoot at the shock / jump", dx, with), worst_overshoot,
+        metric(row("push", "plateau lambda error"), worst_lambda, "<=", 0.02, ""));
+    rep.metrics.push_back(metric(row("push", "plateau sigma error"), worst_sigma, "<=", 0.02, ""));
+    rep.metrics.push_back(metric(row("push", "overshoot at the shock / jump"), worst_overshoot,
                                  "<=", 0.20, ""));
-    rep.metrics.push_back(metric(fmt::format("push, dx = {}{}: max |rho lambda / rho0 - 1| (nodes but the ends)", dx, with),
+    rep.metrics.push_back(metric(row("push", "max |rho lambda / rho0 - 1| (nodes but the ends)"),
                                  worst_rho, "<=", 0.01, ""));
     rep.metrics.push_back(
-        metric(fmt::format("push, dx = {}{}: mass change sum m / sum m0 - 1", dx, with), p.mass_change, "<=", 1e-12, ""));
+        metric(row("push", "mass change sum m / sum m0 - 1"), p.mass_change, "<=", 1e-12, ""));
 
     // ---- pull: a rarefaction fan
     const BarRun q = run_bar(case_file, dx, -kV0, "v2", "simple", rule);
@@ -234,7 +236,7 @@ CaseReport validate_case07(const Options& opt, const std::string& dir) {
       worst_sigma_pull = std::max(worst_sigma_pull, std::abs(sig / count / sigma_pull - 1.0));
     }
     {
-      Metric fan = metric(fmt::format("pull, dx = {}{}: fan e2(lambda - 1)", dx, with), worst_fan, "<=", 0.03, "");
+      Metric fan = metric(row("pull", "fan e2(lambda - 1)"), worst_fan, "<=", 0.03, "");
       if (!fan.pass()) {
         fan.known_deviation =
             "the simple second step is first order and diffusive (method-notes §2.3): it smears the fan, which is only "
@@ -244,13 +246,13 @@ CaseReport validate_case07(const Options& opt, const std::string& dir) {
       rep.metrics.push_back(fan);
     }
     rep.metrics.push_back(
-        metric(fmt::format("pull, dx = {}{}: plateau lambda error", dx, with), worst_plateau, "<=", 0.02, ""));
+        metric(row("pull", "plateau lambda error"), worst_plateau, "<=", 0.02, ""));
     rep.metrics.push_back(
-        metric(fmt::format("pull, dx = {}{}: plateau sigma error", dx, with), worst_sigma_pull, "<=", 0.02, ""));
-    rep.metrics.push_back(metric(fmt::format("pull, dx = {}{}: max |rho lambda / rho0 - 1| (nodes but the ends)", dx, with),
+        metric(row("pull", "plateau sigma error"), worst_sigma_pull, "<=", 0.02, ""));
+    rep.metrics.push_back(metric(row("pull", "max |rho lambda / rho0 - 1| (nodes but the ends)"),
                                  worst_rho_pull, "<=", 0.01, ""));
     rep.metrics.push_back(
-        metric(fmt::format("pull, dx = {}{}: mass change sum m / sum m0 - 1", dx, with), q.mass_change, "<=", 1e-12, ""));
+        metric(row("pull", "mass change sum m / sum m0 - 1"), q.mass_change, "<=", 1e-12, ""));
 
     // ---- the small-strain solution (V1) of the push: the large-deformation terms are active
     if (dx == 0.05 && fixed) {
