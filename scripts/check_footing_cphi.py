@@ -171,6 +171,9 @@ def main():
         print(f"hold at {args.hold:g} s: q moving (mean over the last 0.2 s) = {moving / q_u:.4f} q_u; held: "
               f"{mean_q(args.hold + 0.4, args.hold + 0.6) / q_u:.4f} q_u after 0.5 s, "
               f"{press[-1] / q_u:.4f} q_u at {times[-1]:g} s")
+        marks = [args.hold + 0.5 * k for k in range(1, int((times[-1] - args.hold) / 0.5) + 1)]
+        print("held q/q_u (means over 0.1 s) at " + ", ".join(
+            f"{t - args.hold:g} s: {mean_q(t - 0.05, t + 0.05) / q_u:.4f}" for t in marks))
         sys.exit(0)
     s_end = settle[-1]
     window = [(s, q) for s, q in zip(settle, press) if s >= 0.75 * s_end]

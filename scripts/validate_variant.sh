@@ -2,10 +2,11 @@
 # Run `rktsph validate` on a copy of cases/ with keys overridden, to reproduce the variant
 # comparisons of docs/VALIDATION.md (validate has no --set: its cases read their own files).
 #
-#   scripts/validate_variant.sh [--only GLOB] OUT TABLE.KEY=VALUE... -- [validate options] CASES...
+#   scripts/validate_variant.sh [--only GLOB] [--add] OUT TABLE.KEY=VALUE... -- [validate options] CASES...
 #
 # Every thesis and example case file matching GLOB (default: all) that has the [TABLE] header
-# gets `KEY = VALUE` as the first line of that table; a line setting KEY anywhere else in the
+# gets `KEY = VALUE` as the first line of that table (with --add, a file without the table gets
+# it appended); a line setting KEY anywhere else in the
 # file is removed (so KEY must name one key of the file only: true of the keys used below). The
 # report goes to OUT/report. Example, the odd-even filter at half strength on the V3 cases:
 #
@@ -17,6 +18,11 @@ only='*'
 if [ "${1:-}" = "--only" ]; then
   only=$2
   shift 2
+fi
+add=0
+if [ "${1:-}" = "--add" ]; then
+  add=1
+  shift
 fi
 [ $# -ge 2 ] || { echo "usage: $0 [--only GLOB] OUT TABLE.KEY=VALUE... -- [validate options] CASES..." >&2; exit 2; }
 out=$1
@@ -33,7 +39,10 @@ while [ $# -gt 0 ] && [ "$1" != "--" ]; do
   found=0
   for f in "$out"/cases/thesis/$only.toml "$out"/cases/examples/$only.toml; do
     [ -f "$f" ] || continue
-    grep -q "^\[$table\]" "$f" || continue
+    if ! grep -q "^\[$table\]" "$f"; then
+      [ "$add" -eq 1 ] || continue
+      printf '\n[%s]\n' "$table" >>"$f"
+    fi
     sed -i "/^$key *=/d; s|^\[$table\]\$|[$table]\n$key = $value|" "$f"
     found=$((found + 1))
   done
