@@ -10,6 +10,7 @@
 #include "core/error.hpp"
 #include "io/state_archive.hpp"
 #include "operators/laplacian.hpp"
+#include "operators/run_sums.hpp"
 
 namespace rktsph {
 
@@ -326,6 +327,31 @@ std::size_t PorePressureStage<Dim>::scratch_bytes() const {
          node_operator_.bytes() + (solver_ != nullptr ? solver_->bytes() : 0) + face_coupling_.bytes();
 }
 
+namespace {
+
+// The same-set corrected gradient (acc[d], d < Dim) of a nodal field of N values per node at
+// the rows of run r of `op`, summed over the run's rows together (operators/run_sums.hpp). Eight
+// lanes, not V1's sixteen: a run holds at most 16 rows of one or two values here, so sixteen
+// lanes would leave most sums in run_sums' variable-width tail (measured: 3.0e6 against 4.2e6
+// node-steps/s of BM_V3Step at 1e5 nodes, docs/VALIDATION.md).
+template <int Dim, int N>
+void gradient_run(const CorrectedOperator<Dim>& op, const double* src, Index r,
+                  double (&acc)[Dim][CorrectedOperator<Dim>::kMaxRun * N]) {
+  const Index a0 = op.run_start[static_cast<std::size_t>(r)], a1 = op.run_start[static_cast<std::size_t>(r) + 1];
+  const auto p = static_cast<std::size_t>(op.pattern[static_cast<std::size_t>(a0)]);
+  double* sums[Dim];
+  for (int d = 0; d < Dim; ++d) sums[d] = acc[d];
+  run_sums<Dim, 8>(
+      src + static_cast<std::size_t>(op.base[static_cast<std::size_t>(a0)]) * N, N,
+      static_cast<std::size_t>(a1 - a0) * N, op.offset.data(), op.pattern_start[p], op.pattern_start[p + 1],
+      [&](Index k, double* w) {
+        for (int d = 0; d < Dim; ++d) w[d] = op.grad[static_cast<std::size_t>(k)][static_cast<std::size_t>(d)];
+      },
+      sums);
+}
+
+}  // namespace
+
 template <int Dim>
 void PorePressureStage<Dim>::run(const StepContext& context) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -343,17 +369,9 @@ void PorePressureStage<Dim>::run(const StepContext& context) {
   const Index* pat = op.pattern.data();
   const Index* pstart = op.pattern_start.data();
   const Index* off = op.offset.data();
-  const auto* wg = op.grad.data();
   auto v = m_.nodes.view(m_.fields.velocity);
   double* pw = pw_view.data();
-  // Same-set corrected gradient of a nodal scalar at node i (that of the velocity correction).
-  auto node_gradient = [&](const double* f, Index i, double(&g)[Dim]) {
-    for (int d = 0; d < Dim; ++d) g[d] = 0.0;
-    for (Index k = pstart[pat[i]]; k < pstart[pat[i] + 1]; ++k) {
-      const double fk = f[static_cast<std::size_t>(base[i] + off[k])];
-      for (int d = 0; d < Dim; ++d) g[d] += wg[k][static_cast<std::size_t>(d)] * fk;
-    }
-  };
+
   // RHS_I = p^n_I/(Q* dt) - S_w (div v*)_I; drained nodes take their value at t^{n+1}.
   //
   // solver.pressure_divergence = "stress_points": div of the stress points' pressure-free half-
@@ -368,25 +386,37 @@ void PorePressureStage<Dim>::run(const StepContext& context) {
   const bool from_stress_points = !skeleton_.empty();
   const CorrectedOperator<Dim>& to_nodes = m_.to_nodes;
   const FieldView<const double, Dim> skeleton(skeleton_.data(), m_.stress_points.size(), Dim);
-  exec::particle_for(m_.policy, nn, [&](Index i) {
+  auto source_at = [&](Index i, double div) {
     const auto iu = static_cast<std::size_t>(i);
-    double div = 0.0;
-    if (from_stress_points) {
+    source_[iu] = pw_old[iu] * inv_q_dt - sw * div;
+    if (conditions_.drained[iu]) pw[iu] = conditions_.value[iu] * m_.function_value(conditions_.function[iu], t_new);
+  };
+  if (from_stress_points) {
+    exec::particle_for(m_.policy, nn, [&](Index i) {
+      double div = 0.0;
       const auto r = to_nodes.row(i);
       for (Index k = r.begin; k < r.end; ++k) {
         const double* ve = skeleton[to_nodes.source(r, k)];
         for (int d = 0; d < Dim; ++d)
           div += to_nodes.grad[static_cast<std::size_t>(k)][static_cast<std::size_t>(d)] * ve[d];
       }
-    } else {
-      for (Index k = pstart[pat[i]]; k < pstart[pat[i] + 1]; ++k) {
-        const double* vk = v[base[i] + off[k]];
-        for (int d = 0; d < Dim; ++d) div += wg[k][static_cast<std::size_t>(d)] * vk[d];
-      }
-    }
-    source_[iu] = pw_old[iu] * inv_q_dt - sw * div;
-    if (conditions_.drained[iu]) pw[iu] = conditions_.value[iu] * m_.function_value(conditions_.function[iu], t_new);
-  });
+      source_at(i, div);
+    });
+  } else {
+    exec::particle_for(
+        m_.policy, op.runs(),
+        [&](Index r) {
+          double acc[Dim][CorrectedOperator<Dim>::kMaxRun * Dim];
+          gradient_run<Dim, Dim>(op, v.data(), r, acc);
+          const Index i0 = op.run_start[static_cast<std::size_t>(r)];
+          for (Index i = i0; i < op.run_start[static_cast<std::size_t>(r) + 1]; ++i) {
+            double div = 0.0;
+            for (int d = 0; d < Dim; ++d) div += acc[d][static_cast<std::size_t>(i - i0) * Dim + static_cast<std::size_t>(d)];
+            source_at(i, div);
+          }
+        },
+        exec::Schedule::even, nn);
+  }
   if (!pressure_gradient_.empty()) {
     // Incremental projection (solver.pressure_incremental): add S_w dt div(grad p^n / rho) to the
     // source; the solver subtracts S_w (dt/rho) L p^n, so the stabilisation acts on p^{n+1} - p^n.
@@ -394,11 +424,18 @@ void PorePressureStage<Dim>::run(const StepContext& context) {
     // mirror (impermeable) rows of L no longer constrain the hydrostatic-like gradient that
     // carries the load, which in the non-incremental form leaks pore pressure through the walls.
     FieldView<double, Dim> grad(pressure_gradient_.data(), nn, Dim);
-    exec::particle_for(m_.policy, nn, [&](Index i) {
-      double g[Dim];
-      node_gradient(pw_old.data(), i, g);
-      for (int d = 0; d < Dim; ++d) grad(i, d) = g[d] / nodes.density[static_cast<std::size_t>(i)];
-    });
+    exec::particle_for(
+        m_.policy, op.runs(),
+        [&](Index r) {
+          double acc[Dim][CorrectedOperator<Dim>::kMaxRun];
+          gradient_run<Dim, 1>(op, pw_old.data(), r, acc);
+          const Index i0 = op.run_start[static_cast<std::size_t>(r)];
+          for (Index i = i0; i < op.run_start[static_cast<std::size_t>(r) + 1]; ++i) {
+            const double inv_rho = 1.0 / nodes.density[static_cast<std::size_t>(i)];
+            for (int d = 0; d < Dim; ++d) grad(i, d) = acc[d][static_cast<std::size_t>(i - i0)] * inv_rho;
+          }
+        },
+        exec::Schedule::even, nn);
     // A prescribed velocity component is not corrected (the constraints reset it), so it
     // carries no pressure-gradient term in v* - (dt/rho) grad p^n either.
     for (const Index i : m_.constraints.constrained()) {
@@ -407,14 +444,19 @@ void PorePressureStage<Dim>::run(const StepContext& context) {
         if (c.component < Dim) grad(i, c.component) = 0.0;
       }
     }
-    exec::particle_for(m_.policy, nn, [&](Index i) {
-      double div = 0.0;
-      for (Index k = pstart[pat[i]]; k < pstart[pat[i] + 1]; ++k) {
-        const double* g = grad[base[i] + off[k]];
-        for (int d = 0; d < Dim; ++d) div += wg[k][static_cast<std::size_t>(d)] * g[d];
-      }
-      source_[static_cast<std::size_t>(i)] += sw * stabilisation_time_ * div;
-    });
+    exec::particle_for(
+        m_.policy, op.runs(),
+        [&](Index r) {
+          double acc[Dim][CorrectedOperator<Dim>::kMaxRun * Dim];
+          gradient_run<Dim, Dim>(op, grad.data(), r, acc);
+          const Index i0 = op.run_start[static_cast<std::size_t>(r)];
+          for (Index i = i0; i < op.run_start[static_cast<std::size_t>(r) + 1]; ++i) {
+            double div = 0.0;
+            for (int d = 0; d < Dim; ++d) div += acc[d][static_cast<std::size_t>(i - i0) * Dim + static_cast<std::size_t>(d)];
+            source_[static_cast<std::size_t>(i)] += sw * stabilisation_time_ * div;
+          }
+        },
+        exec::Schedule::even, nn);
   }
   solve_with_bodies();
   if (!odd_even_amplitude_.empty()) {
@@ -422,23 +464,33 @@ void PorePressureStage<Dim>::run(const StepContext& context) {
     // gradient nor the stress points see inside the body, off p^{n+1}; drained nodes stay pinned.
     const double alpha = m_.setup.fluid.odd_even_filter;
     const double* w = odd_even_weight_.data();
-    exec::particle_for(m_.policy, nn, [&](Index i) {
-      double a = 0.0;
-      for (Index k = pstart[pat[i]]; k < pstart[pat[i] + 1]; ++k) a += w[k] * pw[base[i] + off[k]];
-      odd_even_amplitude_[static_cast<std::size_t>(i)] = a;
-    });
+    exec::particle_for(
+        m_.policy, op.runs(),
+        [&](Index r) {
+          const Index a0 = op.run_start[static_cast<std::size_t>(r)], a1 = op.run_start[static_cast<std::size_t>(r) + 1];
+          double* out[1] = {odd_even_amplitude_.data() + a0};
+          run_sums<1, 8>(pw + base[a0], 1, static_cast<std::size_t>(a1 - a0), off, pstart[pat[a0]],
+                          pstart[pat[a0] + 1], [&](Index k, double* wk) { wk[0] = w[k]; }, out);
+        },
+        exec::Schedule::even, nn);
     exec::particle_for(m_.policy, nn, [&](Index i) {
       const auto iu = static_cast<std::size_t>(i);
       if (!conditions_.drained[iu]) pw[iu] -= alpha * odd_even_amplitude_[iu];
     });
   }
   // Velocity correction v^{n+1} = v* - (dt/rho) grad p^{n+1} (same-set corrected gradient).
-  exec::particle_for(m_.policy, nn, [&](Index i) {
-    double g[Dim];
-    node_gradient(pw, i, g);
-    const double f = dt / nodes.density[static_cast<std::size_t>(i)];
-    for (int d = 0; d < Dim; ++d) v(i, d) -= f * g[d];
-  });
+  exec::particle_for(
+      m_.policy, op.runs(),
+      [&](Index r) {
+        double acc[Dim][CorrectedOperator<Dim>::kMaxRun];
+        gradient_run<Dim, 1>(op, pw, r, acc);
+        const Index i0 = op.run_start[static_cast<std::size_t>(r)];
+        for (Index i = i0; i < op.run_start[static_cast<std::size_t>(r) + 1]; ++i) {
+          const double f = dt / nodes.density[static_cast<std::size_t>(i)];
+          for (int d = 0; d < Dim; ++d) v(i, d) -= f * acc[d][static_cast<std::size_t>(i - i0)];
+        }
+      },
+      exec::Schedule::even, nn);
   // The face condition at t^{n+1}: v += B (p^{n+1} - p^n) (method-notes eq. (2.4.16)).
   if (!face_coupling_.empty()) face_coupling_.add_velocity(v, pw, pw_old.data());
   seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
