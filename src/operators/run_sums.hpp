@@ -85,4 +85,24 @@ inline void interpolate_run(const CorrectedOperator<Dim>& op, const double* src,
       sums);
 }
 
+// The gradient alone (acc[d], d < Dim) at the rows of run r of `op` of the field `src` of N
+// values per source, L lanes wide. For fields of one or two values a run of at most kMaxRun
+// rows spans at most 32 doubles: with eight lanes most of it is in full blocks, with sixteen
+// most falls in run_sums' variable-width tail (measured slower, docs/VALIDATION.md).
+template <int Dim, int N, std::size_t L = 8>
+inline void gradient_run(const CorrectedOperator<Dim>& op, const double* src, Index r,
+                         double (&acc)[Dim][CorrectedOperator<Dim>::kMaxRun * N]) {
+  const Index a0 = op.run_start[static_cast<std::size_t>(r)], a1 = op.run_start[static_cast<std::size_t>(r) + 1];
+  const auto p = static_cast<std::size_t>(op.pattern[static_cast<std::size_t>(a0)]);
+  double* sums[Dim];
+  for (int d = 0; d < Dim; ++d) sums[d] = acc[d];
+  run_sums<Dim, L>(
+      src + static_cast<std::size_t>(op.base[static_cast<std::size_t>(a0)]) * N, N,
+      static_cast<std::size_t>(a1 - a0) * N, op.offset.data(), op.pattern_start[p], op.pattern_start[p + 1],
+      [&](Index k, double* w) {
+        for (int d = 0; d < Dim; ++d) w[d] = op.grad[static_cast<std::size_t>(k)][static_cast<std::size_t>(d)];
+      },
+      sums);
+}
+
 }  // namespace rktsph

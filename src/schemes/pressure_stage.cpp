@@ -327,31 +327,6 @@ std::size_t PorePressureStage<Dim>::scratch_bytes() const {
          node_operator_.bytes() + (solver_ != nullptr ? solver_->bytes() : 0) + face_coupling_.bytes();
 }
 
-namespace {
-
-// The same-set corrected gradient (acc[d], d < Dim) of a nodal field of N values per node at
-// the rows of run r of `op`, summed over the run's rows together (operators/run_sums.hpp). Eight
-// lanes, not V1's sixteen: a run holds at most 16 rows of one or two values here, so sixteen
-// lanes would leave most sums in run_sums' variable-width tail (measured: 3.0e6 against 4.2e6
-// node-steps/s of BM_V3Step at 1e5 nodes, docs/VALIDATION.md).
-template <int Dim, int N>
-void gradient_run(const CorrectedOperator<Dim>& op, const double* src, Index r,
-                  double (&acc)[Dim][CorrectedOperator<Dim>::kMaxRun * N]) {
-  const Index a0 = op.run_start[static_cast<std::size_t>(r)], a1 = op.run_start[static_cast<std::size_t>(r) + 1];
-  const auto p = static_cast<std::size_t>(op.pattern[static_cast<std::size_t>(a0)]);
-  double* sums[Dim];
-  for (int d = 0; d < Dim; ++d) sums[d] = acc[d];
-  run_sums<Dim, 8>(
-      src + static_cast<std::size_t>(op.base[static_cast<std::size_t>(a0)]) * N, N,
-      static_cast<std::size_t>(a1 - a0) * N, op.offset.data(), op.pattern_start[p], op.pattern_start[p + 1],
-      [&](Index k, double* w) {
-        for (int d = 0; d < Dim; ++d) w[d] = op.grad[static_cast<std::size_t>(k)][static_cast<std::size_t>(d)];
-      },
-      sums);
-}
-
-}  // namespace
-
 template <int Dim>
 void PorePressureStage<Dim>::run(const StepContext& context) {
   const auto t0 = std::chrono::steady_clock::now();

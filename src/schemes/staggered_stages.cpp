@@ -104,7 +104,6 @@ void StressPointHalfStep<Dim, PressureTerm, Motion>::run(const StepContext& c) {
   const Index* pstart = op.pattern_start.data();
   const Index* off = op.offset.data();
   const double* wi = op.interp.data();
-  const auto* wg = op.grad.data();
   const auto node_v = std::as_const(m_.nodes).view(m_.fields.velocity);
   const auto node_s = std::as_const(m_.nodes).view(m_.fields.stress);
   const auto node_k = std::as_const(m_.nodes).view(m_.fields.history);
@@ -126,6 +125,8 @@ void StressPointHalfStep<Dim, PressureTerm, Motion>::run(const StepContext& c) {
         const Index k0 = pstart[pat[e0]], k1 = pstart[pat[e0] + 1];
         interpolate_run<Dim, Dim>(op, node_v.data(), r, acc_v);
         interpolate_run<Dim, NS>(op, node_s.data(), r, acc_s);
+        [[maybe_unused]] double acc_p[Dim][CorrectedOperator<Dim>::kMaxRun];
+        if constexpr (PressureTerm::kActive) gradient_run<Dim, 1>(op, pressure.pressure, r, acc_p);
         for (Index e = e0; e < e1; ++e) {
           const auto sv = static_cast<std::size_t>(e - e0) * Dim;
           const auto ss = static_cast<std::size_t>(e - e0) * NS;
@@ -150,10 +151,8 @@ void StressPointHalfStep<Dim, PressureTerm, Motion>::run(const StepContext& c) {
             if (pressure.skeleton.data() != nullptr) {
               for (int i = 0; i < Dim; ++i) pressure.skeleton(e, i) = damped_velocity(bar_v[i], dv[i] + b[i], cd, tau);
             }
-            for (Index k = k0; k < k1; ++k) {
-              const double pr = pressure.pressure[static_cast<std::size_t>(base[e] + off[k])] / sp.density[eu];
-              for (int d = 0; d < Dim; ++d) dv[d] -= wg[k][static_cast<std::size_t>(d)] * pr;
-            }
+            const double inv_rho = 1.0 / sp.density[eu];
+            for (int d = 0; d < Dim; ++d) dv[d] -= acc_p[d][static_cast<std::size_t>(e - e0)] * inv_rho;
           }
           for (int i = 0; i < Dim; ++i) sp_v(e, i) = damped_velocity(bar_v[i], dv[i] + b[i], cd, tau);
           if constexpr (Motion::kMoving) {
