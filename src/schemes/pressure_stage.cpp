@@ -366,6 +366,38 @@ void PorePressureStage<Dim>::run(const StepContext& context) {
     source_[iu] = pw_old[iu] * inv_q_dt - sw * div;
     if (conditions_.drained[iu]) pw[iu] = conditions_.value[iu] * m_.function_value(conditions_.function[iu], t_new);
   };
+  // The node operator's divergence of a field of Dim values, or gradient of a scalar, at every
+  // node, summed over runs of rows (operators/run_sums.hpp), handed to `use` row by row.
+  auto each_divergence = [&](const double* field, auto&& use) {
+    exec::particle_for(
+        m_.policy, op.runs(),
+        [&](Index r) {
+          double acc[Dim][CorrectedOperator<Dim>::kMaxRun * Dim];
+          gradient_run<Dim, Dim>(op, field, r, acc);
+          const Index i0 = op.run_start[static_cast<std::size_t>(r)];
+          for (Index i = i0; i < op.run_start[static_cast<std::size_t>(r) + 1]; ++i) {
+            double div = 0.0;
+            for (int d = 0; d < Dim; ++d) div += acc[d][static_cast<std::size_t>(i - i0) * Dim + static_cast<std::size_t>(d)];
+            use(i, div);
+          }
+        },
+        exec::Schedule::even, nn);
+  };
+  auto each_gradient = [&](const double* field, auto&& use) {
+    exec::particle_for(
+        m_.policy, op.runs(),
+        [&](Index r) {
+          double acc[Dim][CorrectedOperator<Dim>::kMaxRun];
+          gradient_run<Dim, 1>(op, field, r, acc);
+          const Index i0 = op.run_start[static_cast<std::size_t>(r)];
+          for (Index i = i0; i < op.run_start[static_cast<std::size_t>(r) + 1]; ++i) {
+            double g[Dim];
+            for (int d = 0; d < Dim; ++d) g[d] = acc[d][static_cast<std::size_t>(i - i0)];
+            use(i, g);
+          }
+        },
+        exec::Schedule::even, nn);
+  };
   if (from_stress_points) {
     exec::particle_for(m_.policy, nn, [&](Index i) {
       double div = 0.0;
@@ -378,19 +410,7 @@ void PorePressureStage<Dim>::run(const StepContext& context) {
       source_at(i, div);
     });
   } else {
-    exec::particle_for(
-        m_.policy, op.runs(),
-        [&](Index r) {
-          double acc[Dim][CorrectedOperator<Dim>::kMaxRun * Dim];
-          gradient_run<Dim, Dim>(op, v.data(), r, acc);
-          const Index i0 = op.run_start[static_cast<std::size_t>(r)];
-          for (Index i = i0; i < op.run_start[static_cast<std::size_t>(r) + 1]; ++i) {
-            double div = 0.0;
-            for (int d = 0; d < Dim; ++d) div += acc[d][static_cast<std::size_t>(i - i0) * Dim + static_cast<std::size_t>(d)];
-            source_at(i, div);
-          }
-        },
-        exec::Schedule::even, nn);
+    each_divergence(v.data(), source_at);
   }
   if (!pressure_gradient_.empty()) {
     // Incremental projection (solver.pressure_incremental): add S_w dt div(grad p^n / rho) to the
@@ -399,18 +419,10 @@ void PorePressureStage<Dim>::run(const StepContext& context) {
     // mirror (impermeable) rows of L no longer constrain the hydrostatic-like gradient that
     // carries the load, which in the non-incremental form leaks pore pressure through the walls.
     FieldView<double, Dim> grad(pressure_gradient_.data(), nn, Dim);
-    exec::particle_for(
-        m_.policy, op.runs(),
-        [&](Index r) {
-          double acc[Dim][CorrectedOperator<Dim>::kMaxRun];
-          gradient_run<Dim, 1>(op, pw_old.data(), r, acc);
-          const Index i0 = op.run_start[static_cast<std::size_t>(r)];
-          for (Index i = i0; i < op.run_start[static_cast<std::size_t>(r) + 1]; ++i) {
-            const double inv_rho = 1.0 / nodes.density[static_cast<std::size_t>(i)];
-            for (int d = 0; d < Dim; ++d) grad(i, d) = acc[d][static_cast<std::size_t>(i - i0)] * inv_rho;
-          }
-        },
-        exec::Schedule::even, nn);
+    each_gradient(pw_old.data(), [&](Index i, const double* g) {
+      const double inv_rho = 1.0 / nodes.density[static_cast<std::size_t>(i)];
+      for (int d = 0; d < Dim; ++d) grad(i, d) = g[d] * inv_rho;
+    });
     // A prescribed velocity component is not corrected (the constraints reset it), so it
     // carries no pressure-gradient term in v* - (dt/rho) grad p^n either.
     for (const Index i : m_.constraints.constrained()) {
@@ -419,19 +431,9 @@ void PorePressureStage<Dim>::run(const StepContext& context) {
         if (c.component < Dim) grad(i, c.component) = 0.0;
       }
     }
-    exec::particle_for(
-        m_.policy, op.runs(),
-        [&](Index r) {
-          double acc[Dim][CorrectedOperator<Dim>::kMaxRun * Dim];
-          gradient_run<Dim, Dim>(op, grad.data(), r, acc);
-          const Index i0 = op.run_start[static_cast<std::size_t>(r)];
-          for (Index i = i0; i < op.run_start[static_cast<std::size_t>(r) + 1]; ++i) {
-            double div = 0.0;
-            for (int d = 0; d < Dim; ++d) div += acc[d][static_cast<std::size_t>(i - i0) * Dim + static_cast<std::size_t>(d)];
-            source_[static_cast<std::size_t>(i)] += sw * stabilisation_time_ * div;
-          }
-        },
-        exec::Schedule::even, nn);
+    each_divergence(grad.data(), [&](Index i, double div) {
+      source_[static_cast<std::size_t>(i)] += sw * stabilisation_time_ * div;
+    });
   }
   solve_with_bodies();
   if (!odd_even_amplitude_.empty()) {
@@ -454,18 +456,10 @@ void PorePressureStage<Dim>::run(const StepContext& context) {
     });
   }
   // Velocity correction v^{n+1} = v* - (dt/rho) grad p^{n+1} (same-set corrected gradient).
-  exec::particle_for(
-      m_.policy, op.runs(),
-      [&](Index r) {
-        double acc[Dim][CorrectedOperator<Dim>::kMaxRun];
-        gradient_run<Dim, 1>(op, pw, r, acc);
-        const Index i0 = op.run_start[static_cast<std::size_t>(r)];
-        for (Index i = i0; i < op.run_start[static_cast<std::size_t>(r) + 1]; ++i) {
-          const double f = dt / nodes.density[static_cast<std::size_t>(i)];
-          for (int d = 0; d < Dim; ++d) v(i, d) -= f * acc[d][static_cast<std::size_t>(i - i0)];
-        }
-      },
-      exec::Schedule::even, nn);
+  each_gradient(pw, [&](Index i, const double* g) {
+    const double f = dt / nodes.density[static_cast<std::size_t>(i)];
+    for (int d = 0; d < Dim; ++d) v(i, d) -= f * g[d];
+  });
   // The face condition at t^{n+1}: v += B (p^{n+1} - p^n) (method-notes eq. (2.4.16)).
   if (!face_coupling_.empty()) face_coupling_.add_velocity(v, pw, pw_old.data());
   seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
