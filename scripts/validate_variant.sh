@@ -5,10 +5,10 @@
 #   scripts/validate_variant.sh [--only GLOB] [--add] OUT TABLE.KEY=VALUE... -- [validate options] CASES...
 #
 # Every thesis and example case file matching GLOB (default: all) that has the [TABLE] header
-# gets `KEY = VALUE` as the first line of that table (with --add, a file without the table gets
-# it appended); a line setting KEY anywhere else in the
-# file is removed (so KEY must name one key of the file only: true of the keys used below). The
-# report goes to OUT/report. Example, the odd-even filter at half strength on the V3 cases:
+# gets `KEY = VALUE` as the first line of that table (with --add, given after --only, a file
+# without the table gets it appended); a line setting KEY anywhere else in the file is removed
+# (so KEY must name one key of the file only: true of the keys used below). The report goes to
+# OUT/report. Example, the odd-even filter at half strength on the V3 cases:
 #
 #   scripts/validate_variant.sh --only '1[3-7]_*' /tmp/half solver.pressure_odd_even_filter=0.5 -- 13 14 15 16 17
 #   scripts/validate_variant.sh --only '16_*' /tmp/c05 time.cfl=0.5 -- --full 16
@@ -24,7 +24,7 @@ if [ "${1:-}" = "--add" ]; then
   add=1
   shift
 fi
-[ $# -ge 2 ] || { echo "usage: $0 [--only GLOB] OUT TABLE.KEY=VALUE... -- [validate options] CASES..." >&2; exit 2; }
+[ $# -ge 2 ] || { echo "usage: $0 [--only GLOB] [--add] OUT TABLE.KEY=VALUE... -- [validate options] CASES..." >&2; exit 2; }
 out=$1
 shift
 rm -rf "$out/cases"

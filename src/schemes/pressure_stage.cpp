@@ -346,7 +346,6 @@ void PorePressureStage<Dim>::run(const StepContext& context) {
   const Index* off = op.offset.data();
   auto v = m_.nodes.view(m_.fields.velocity);
   double* pw = pw_view.data();
-
   // RHS_I = p^n_I/(Q* dt) - S_w (div v*)_I; drained nodes take their value at t^{n+1}.
   //
   // solver.pressure_divergence = "stress_points": div of the stress points' pressure-free half-
