@@ -536,14 +536,14 @@ int run_loop(const LoopInput& in) {
           pressure->impermeable_stress_face_nodes(), pressure->undrained_courant());
     }
     if (pressure != nullptr && pressure->impermeable_stress_face_nodes() > 0 && !pressure->implicit_faces() &&
-        pressure->undrained_courant() > PorePressureStage<Dim>::kUndrainedCourantLimit) {
+        pressure->undrained_courant() > pressure->undrained_courant_limit()) {
       std::cerr << fmt::format(
           "warning: {} boundary nodes are on impermeable faces that carry a total stress (or are free), and the "
           "undrained Courant number C c_u/c_d = {:.2f} exceeds {}, above which such faces have been measured "
           "unstable; time.cfl <= {:.3f} keeps it below (docs/VALIDATION.md, Case 16)\n",
           pressure->impermeable_stress_face_nodes(), pressure->undrained_courant(),
-          PorePressureStage<Dim>::kUndrainedCourantLimit,
-          solver.cfl() * PorePressureStage<Dim>::kUndrainedCourantLimit / pressure->undrained_courant());
+          pressure->undrained_courant_limit(),
+          solver.cfl() * pressure->undrained_courant_limit() / pressure->undrained_courant());
     }
     if (solver.degenerate_operator_rows() > 0) {
       std::cerr << fmt::format(

@@ -261,19 +261,28 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
                fmt::format("must lie in [1, {}], got {}", std::numeric_limits<int>::max(), max_iterations));
     c.fluid.max_iterations = static_cast<int>(max_iterations);
     c.fluid.deferred_correction = s->boolean("pressure_deferred_correction", true);
-    const std::string divergence = s->string("pressure_divergence", "nodes");
-    if (divergence == "nodes")
-      c.fluid.divergence_from_stress_points = false;
+    using StorageRate = FluidSpec::StorageRate;
+    const std::string divergence = s->string("pressure_divergence", "consistent");
+    if (divergence == "consistent")
+      c.fluid.storage_rate = StorageRate::consistent;
+    else if (divergence == "nodes")
+      c.fluid.storage_rate = StorageRate::nodes;
     else if (divergence == "stress_points")
-      c.fluid.divergence_from_stress_points = true;
+      c.fluid.storage_rate = StorageRate::stress_points;
     else
-      s->fail("pressure_divergence", fmt::format("unknown value '{}' (known: nodes, stress_points)", divergence));
-    // The incremental projection is the default with div v* at the nodes. With the stress
-    // points' velocity it is unstable (an undrained column blows up within 0.5 s), so there the
-    // default is the non-incremental form and asking for both is an error.
-    c.fluid.incremental = s->boolean("pressure_incremental", !c.fluid.divergence_from_stress_points);
-    s->require(!(c.fluid.incremental && c.fluid.divergence_from_stress_points), "pressure_incremental",
+      s->fail("pressure_divergence",
+              fmt::format("unknown value '{}' (known: consistent, nodes, stress_points)", divergence));
+    // The incremental projection is the default. With the stress points' pressure-free velocity
+    // it is unstable (an undrained column blows up within 0.5 s), so there the default is the
+    // non-incremental form and asking for both is an error; the consistent form is built on the
+    // incremental one (method-notes eq. (2.4.20)) and needs it.
+    const bool pressure_free = c.fluid.storage_rate == StorageRate::stress_points;
+    c.fluid.incremental = s->boolean("pressure_incremental", !pressure_free);
+    s->require(!(c.fluid.incremental && pressure_free), "pressure_incremental",
                "cannot be true with pressure_divergence = \"stress_points\" (the combination is unstable)");
+    s->require(c.fluid.incremental || c.fluid.storage_rate != StorageRate::consistent, "pressure_incremental",
+               "cannot be false with pressure_divergence = \"consistent\" (the default; it is built on the "
+               "incremental projection): set pressure_divergence = \"nodes\" for the non-incremental form");
     const std::string faces = s->string("pressure_faces", "auto");
     if (faces == "auto")
       c.fluid.face_condition = FluidSpec::FaceCondition::automatic;

@@ -109,10 +109,13 @@ struct FluidSpec {
   /// Incremental pressure projection (method-notes §2.4 "Incremental variant"): the stabilisation
   /// (S_w dt/rho) L acts on p^{n+1} - p^n instead of p^{n+1}.
   bool incremental = true;
-  /// solver.pressure_divergence = "stress_points": the storage equation takes div of the stress
-  /// points' pressure-free half-step velocity, with the stabilisation S_w (dt/2)/rho (source-free
-  /// when the stress points are at rest; method-notes §2.4).
-  bool divergence_from_stress_points = false;
+  /// solver.pressure_divergence: which volumetric rate drives the storage equation (method-notes
+  /// §2.4). consistent (default): the stress points' divergence, the rate that sigma' integrates,
+  /// plus the change of the nodes' divergence over the step (eq. (2.4.20)); nodes: div v* at the
+  /// nodes (eq. (2.4.8)); stress_points: div of the stress points' pressure-free half-step
+  /// velocity with the stabilisation S_w (dt/2)/rho (eq. (2.4.14)).
+  enum class StorageRate { consistent, nodes, stress_points };
+  StorageRate storage_rate = StorageRate::consistent;
   /// solver.pressure_faces: the effective-stress condition at impermeable faces that carry a
   /// total stress, taken at t^{n+1} in the pressure step (implicit, method-notes eq. (2.4.16)) or
   /// with p^n (explicit: stable only below C c_u/c_d = 3.5, eq. (4.3.2)); automatic: implicit

@@ -80,8 +80,17 @@ PorePressureStage<Dim>::PorePressureStage(StaggeredModel<Dim>& model) : m_(model
   s.inv_q_dt = inv_storage_ / dt;
   // The stabilisation time is dt with div v* at the nodes (method-notes §2.4) and dt/2 with the
   // stress points' half-step velocity, which carries (dt/2) grad p / rho in a quasi-static state.
-  stabilisation_time_ = fl.divergence_from_stress_points ? 0.5 * dt : dt;
-  if (fl.divergence_from_stress_points) skeleton_.assign(static_cast<std::size_t>(m_.stress_points.size()) * Dim, 0.0);
+  using StorageRate = FluidSpec::StorageRate;
+  const bool pressure_free = fl.storage_rate == StorageRate::stress_points;
+  stabilisation_time_ = pressure_free ? 0.5 * dt : dt;
+  if (pressure_free) skeleton_.assign(static_cast<std::size_t>(m_.stress_points.size()) * Dim, 0.0);
+  if (fl.storage_rate == StorageRate::consistent) {
+    volumetric_rate_.assign(nn, 0.0);
+    previous_divergence_.assign(nn, 0.0);
+    // Measured: the explicit face condition is stable up to C c_u/c_d = 2.4-2.5, not at 2.6-2.7.
+    explicit_limit_ = 2.5;
+    auto_threshold_ = 2.0;
+  }
   s.k_eff = fl.permeability() + fl.saturation * stabilisation_time_ / rho;
   s.tolerance = fl.tolerance;
   s.max_iterations = fl.max_iterations;
@@ -100,8 +109,8 @@ PorePressureStage<Dim>::PorePressureStage(StaggeredModel<Dim>& model) : m_(model
   const bool implicit_faces =
       fl.face_condition == Faces::implicit ||
       (fl.face_condition == Faces::automatic && impermeable_stress_faces_ > 0 &&
-       undrained_courant_ > kAutoImplicitCourant);
-  if (implicit_faces && !fl.divergence_from_stress_points) {
+       undrained_courant_ > auto_implicit_courant());
+  if (implicit_faces && !pressure_free) {
     face_coupling_ = build_face_pressure_coupling<Dim>(m_, conditions_.drained, node_operator_, dt, fl.saturation);
   }
   const PorePressureSolver::Sparse* coupling = face_coupling_.empty() ? nullptr : &face_coupling_.storage_matrix;
@@ -158,9 +167,10 @@ PorePressureStage<Dim>::PorePressureStage(StaggeredModel<Dim>& model) : m_(model
     odd_even_amplitude_.assign(nn, 0.0);
   }
   if (m_.plates != nullptr && m_.plates->any_force()) {
-    if (fl.divergence_from_stress_points) {
+    if (pressure_free) {
       throw InputError(fmt::format(
-          "{}: a force-driven rigid body needs solver.pressure_divergence = \"nodes\" (the default): its "
+          "{}: a force-driven rigid body needs solver.pressure_divergence = \"consistent\" (the default) or "
+          "\"nodes\": its "
           "velocity is eliminated from the storage equation through the nodal divergence (method-notes §4.6)",
           m_.setup.file));
     }
@@ -282,12 +292,29 @@ void PorePressureStage<Dim>::solve_with_bodies() {
 }
 
 template <int Dim>
+void PorePressureStage<Dim>::record_initial_divergence() {
+  if (previous_divergence_.empty() || previous_divergence_valid_) return;
+  const auto v = std::as_const(m_.nodes).view(m_.fields.velocity);
+  const CorrectedOperator<Dim>& op = node_operator_;
+  exec::particle_for(m_.policy, m_.nodes.size(), [&](Index i) {
+    double div = 0.0;
+    const auto r = op.row(i);
+    for (Index k = r.begin; k < r.end; ++k) {
+      const double* vj = v[op.source(r, k)];
+      for (int d = 0; d < Dim; ++d) div += op.grad[static_cast<std::size_t>(k)][static_cast<std::size_t>(d)] * vj[d];
+    }
+    previous_divergence_[static_cast<std::size_t>(i)] = div;
+  });
+  previous_divergence_valid_ = true;
+}
+
+template <int Dim>
 std::string PorePressureStage<Dim>::instability_hint() const {
-  if (impermeable_stress_faces_ == 0 || undrained_courant_ <= kUndrainedCourantLimit || implicit_faces()) return {};
+  if (impermeable_stress_faces_ == 0 || undrained_courant_ <= explicit_limit_ || implicit_faces()) return {};
   return fmt::format(
       " (V3: impermeable faces carrying a total stress are unstable above C c_u/c_d = {}; "
       "here it is {:.2f}: time.cfl <= {:.3f})",
-      kUndrainedCourantLimit, undrained_courant_, m_.time_step.courant * kUndrainedCourantLimit / undrained_courant_);
+      explicit_limit_, undrained_courant_, m_.time_step.courant * explicit_limit_ / undrained_courant_);
 }
 
 template <int Dim>
@@ -300,6 +327,10 @@ void PorePressureStage<Dim>::save(io::StateArchive& a, const std::string& prefix
                                               static_cast<double>(s.max_iterations), static_cast<double>(s.last_iterations),
                                               s.last_error, s.max_error, s.seconds});
   a.put(prefix + "seconds", seconds_);
+  if (!previous_divergence_.empty()) {
+    a.put(prefix + "previous_divergence", previous_divergence_);
+    a.put_integer(prefix + "previous_divergence_valid", previous_divergence_valid_ ? 1 : 0);
+  }
 }
 
 template <int Dim>
@@ -317,12 +348,18 @@ void PorePressureStage<Dim>::load(const io::StateArchive& a, const std::string& 
   s.seconds = v[6];
   solver_->set_stats(s);
   seconds_ = a.number(prefix + "seconds");
+  if (!previous_divergence_.empty()) {
+    const auto& d = a.doubles(prefix + "previous_divergence");
+    if (d.size() != previous_divergence_.size()) throw InputError("the checkpoint's pressure state is damaged");
+    previous_divergence_ = d;
+    previous_divergence_valid_ = a.integer(prefix + "previous_divergence_valid") != 0;
+  }
 }
 
 template <int Dim>
 std::size_t PorePressureStage<Dim>::scratch_bytes() const {
   return (p_old_.size() + source_.size() + pressure_gradient_.size() + skeleton_.size() + odd_even_weight_.size() +
-          odd_even_amplitude_.size()) *
+          odd_even_amplitude_.size() + volumetric_rate_.size() + previous_divergence_.size()) *
              sizeof(double) +
          node_operator_.bytes() + (solver_ != nullptr ? solver_->bytes() : 0) + face_coupling_.bytes();
 }
@@ -434,6 +471,21 @@ void PorePressureStage<Dim>::run(const StepContext& context) {
       source_[static_cast<std::size_t>(i)] += sw * stabilisation_time_ * div;
     });
   }
+  if (!previous_divergence_.empty()) {
+    // Consistent storage rate (method-notes eq. (2.4.20)): S_w [(D v^n)_I - (D_N v^{n+1/2})_I] on
+    // the right, D_N v^{n+1/2} the trace of step 2's corrected velocity gradient (the rate sigma'
+    // integrates), so that the equation reads that rate plus the change of the node divergence
+    // over the step, D v^{n+1} - D v^n, whose D v^{n+1} is the implicit part above. In a steady
+    // state the nodes' O(dt) velocity that no stress point sees then cancels (Case 15: p_w drains
+    // under the footing edge). D v^0 is the initial velocity's (record_initial_divergence), so
+    // that the nodal terms telescope from the start.
+    const double* rate = volumetric_rate_.data();
+    const double* previous = previous_divergence_.data();
+    exec::particle_for(m_.policy, nn, [&](Index i) {
+      const auto iu = static_cast<std::size_t>(i);
+      source_[iu] += sw * (previous[iu] - rate[iu]);
+    });
+  }
   solve_with_bodies();
   if (!odd_even_amplitude_.empty()) {
     // p <- p - alpha a (method-notes eq. (2.4.19)): the odd-even mode, which neither the nodal
@@ -461,6 +513,13 @@ void PorePressureStage<Dim>::run(const StepContext& context) {
   });
   // The face condition at t^{n+1}: v += B (p^{n+1} - p^n) (method-notes eq. (2.4.16)).
   if (!face_coupling_.empty()) face_coupling_.add_velocity(v, pw, pw_old.data());
+  if (!previous_divergence_.empty()) {
+    // D v^{n+1} for the next step, with the prescribed components at t^{n+1} as the next step's
+    // v* has them (the constraint stage that follows does the same again: it is idempotent).
+    m_.apply_constraints(t_new);
+    each_divergence(v.data(), [&](Index i, double div) { previous_divergence_[static_cast<std::size_t>(i)] = div; });
+    previous_divergence_valid_ = true;
+  }
   seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 

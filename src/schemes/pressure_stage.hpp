@@ -37,6 +37,12 @@ class PorePressureStage final : public Stage {
     return skeleton_.empty() ? FieldView<double, Dim>()
                              : FieldView<double, Dim>(skeleton_.data(), m_.stress_points.size(), Dim);
   }
+  /// Where step 2 writes tr d^{n+1/2} per node (solver.pressure_divergence = "consistent",
+  /// method-notes eq. (2.4.20)); null otherwise.
+  double* volumetric_rate() { return volumetric_rate_.empty() ? nullptr : volumetric_rate_.data(); }
+  /// D v^0 for the consistent storage rate, from the nodal velocity as it is before the first
+  /// step (StorageRateStart runs it); nothing once known (a later step, or a resumed run).
+  void record_initial_divergence();
   /// 1/Q*, 1/Pa.
   double inverse_storage() const { return inv_storage_; }
 
@@ -49,7 +55,7 @@ class PorePressureStage final : public Stage {
   /// largest over the materials, and the number of boundary nodes that are neither drained nor
   /// held in their normal direction (impermeable faces carrying a prescribed, possibly zero,
   /// total stress). The step is unstable at such faces once that Courant number exceeds
-  /// kUndrainedCourantLimit (docs/VALIDATION.md, Case 16).
+  /// undrained_courant_limit() (docs/VALIDATION.md, Case 16).
   double undrained_courant() const { return undrained_courant_; }
   Index impermeable_stress_face_nodes() const { return impermeable_stress_faces_; }
   /// Those faces are taken implicitly (solver.pressure_faces = "implicit"): the limit is gone.
@@ -57,10 +63,14 @@ class PorePressureStage final : public Stage {
   /// Nodes whose pressure-filter gradient was fitted to quadratics (truncated supports;
   /// solver.pressure_filter_gradient = "quadratic" or "quadratic_drained"), for summary.json.
   Index filter_fitted_rows() const { return filter_fitted_rows_; }
-  static constexpr double kUndrainedCourantLimit = 3.5;
-  /// solver.pressure_faces = "auto" takes the faces implicitly above this C c_u/c_d (a margin
-  /// below the measured limit: stable at 2.7, 2.9, 3.4; unstable at 3.6).
-  static constexpr double kAutoImplicitCourant = 2.5;
+  /// The explicit face condition's measured limit on C c_u/c_d: 3.5 with the storage rate
+  /// "nodes" or "stress_points" (stable at 2.7, 2.9, 3.4; unstable at 3.6), 2.5 with
+  /// "consistent" (stable at 2.41 / 2.53, unstable at 2.56 / 2.68 on a 2D sample / 1D column:
+  /// docs/VALIDATION.md).
+  double undrained_courant_limit() const { return explicit_limit_; }
+  /// solver.pressure_faces = "auto" takes the faces implicitly above this C c_u/c_d, a margin
+  /// below the limit: 2.5 ("nodes"), 2.0 ("consistent").
+  double auto_implicit_courant() const { return auto_threshold_; }
   /// The growth guard's hint when the limit above is exceeded (empty otherwise).
   std::string instability_hint() const;
 
@@ -76,6 +86,10 @@ class PorePressureStage final : public Stage {
   std::vector<double> p_old_, source_;
   std::vector<double> pressure_gradient_;  // incremental projection: grad p^n / rho (Dim per node)
   std::vector<double> skeleton_;           // pressure-free half-step velocity (Dim per stress point)
+  /// Consistent storage rate (eq. (2.4.20)): tr d^{n+1/2} from step 2, and (D v^n)_I, the node
+  /// divergence of the velocity this stage left at the last step (invalid before the first).
+  std::vector<double> volumetric_rate_, previous_divergence_;
+  bool previous_divergence_valid_ = false;
   /// Force-driven rigid bodies (small deformation, method-notes eq. (4.6.3)): per coupled
   /// (body, axis) j, its nodes and their weights a_j = -n A_I (the reaction on the body per unit
   /// p_w), dt/M, the divergence per unit body velocity d_j (per node) and z_j = K^{-1} S_w
@@ -94,11 +108,25 @@ class PorePressureStage final : public Stage {
   void couple_bodies();
   void solve_with_bodies();
   double inv_storage_ = 0.0;
-  double stabilisation_time_ = 0.0;  // dt (method-notes §2.4) or dt/2 (stress-point divergence)
+  double stabilisation_time_ = 0.0;  // dt (method-notes §2.4) or dt/2 ("stress_points")
   double undrained_courant_ = 0.0;
+  double explicit_limit_ = 3.5, auto_threshold_ = 2.5;
   Index impermeable_stress_faces_ = 0;
   Index filter_fitted_rows_ = 0;
   double seconds_ = 0.0;
+};
+
+/// First stage of V3 with the consistent storage rate: the initial nodal divergence D v^0 of
+/// method-notes eq. (2.4.20), taken before step 1 changes the velocity.
+template <int Dim>
+class StorageRateStart final : public Stage {
+ public:
+  explicit StorageRateStart(PorePressureStage<Dim>& pressure) : pressure_(pressure) {}
+  std::string_view name() const override { return "storage_rate_start"; }
+  void run(const StepContext& /*context*/) override { pressure_.record_initial_divergence(); }
+
+ private:
+  PorePressureStage<Dim>& pressure_;
 };
 
 }  // namespace rktsph

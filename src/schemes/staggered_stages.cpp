@@ -314,6 +314,13 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
             for (int d = 0; d < Dim; ++d) grad_s[d][s] = acc_s[1 + d][ss + static_cast<std::size_t>(s)];
           }
           const auto iu = static_cast<std::size_t>(i);
+          if (volumetric_rate_ != nullptr) {
+            // The stress points' divergence by the corrected gradient, before fix (a) replaces a
+            // prescribed component's gradient below (V3's storage equation, eq. (2.4.20)).
+            double tr = 0.0;
+            for (int k = 0; k < Dim; ++k) tr += grad_v[k][k];
+            volumetric_rate_[iu] = tr;
+          }
           // The material velocity at t^{n+1/2} for the displacement: the stress points' velocity,
           // interpolated back. Not the nodal v, which in a steady state keeps an O(dt) component
           // the stress points never see (it balances the filter against the residual nodal

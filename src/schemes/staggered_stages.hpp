@@ -99,10 +99,16 @@ class NodeFullStep final : public Stage {
   std::size_t scratch_bytes() const override { return sources_->bytes(); }
   void save(io::StateArchive& archive, const std::string& prefix) const override;
   void load(const io::StateArchive& archive, const std::string& prefix) override;
+  /// Also write the stress points' divergence at t^{n+1/2} per node into `rate` (one value a
+  /// node, 1/s): the trace of the corrected velocity gradient that the effective stress
+  /// integrates (before fix (a) at prescribed components), for V3's consistent storage equation
+  /// (method-notes eq. (2.4.20)). Null: not recorded.
+  void record_volumetric_rate(double* rate) { volumetric_rate_ = rate; }
 
  private:
   StaggeredModel<Dim>& m_;
   std::shared_ptr<ViscoplasticSources<Dim>> sources_;
+  double* volumetric_rate_ = nullptr;
 };
 
 /// The prescribed components at t^{n+1} (method-notes §4.1).

@@ -1,7 +1,8 @@
 // V3: the saturated v-p_w scheme in small deformation (method-notes §5.3): V1's stages with the
 // pore-pressure gradient in the stress points' half step, and the pressure stage after step 2:
+//   0. (consistent storage rate, before the first step only) the initial nodal divergence D v^0
 //   1. stress points: half step with -grad p^n / rho
-//   2. nodes: v*, sigma' (effective stress), displacement
+//   2. nodes: v*, sigma' (effective stress), displacement (and tr d, for the storage equation)
 //   3. prescribed components (total stresses: sigma' = sigma + p_w)
 //   4. pressure: the storage equation by PCG, v^{n+1} = v* - (dt/rho) grad p^{n+1}
 //   5. prescribed components; the velocity filter and the prescribed components again.
@@ -24,8 +25,11 @@ std::unique_ptr<Scheme> make_v3_scheme(StaggeredModel<Dim>& model) {
   gradient.pressure = model.nodes.view(pressure->pore_pressure()).data();
   gradient.skeleton = pressure->skeleton_velocity();
   auto sources = std::make_shared<ViscoplasticSources<Dim>>(model);
+  if (pressure->volumetric_rate() != nullptr) scheme->add(std::make_unique<StorageRateStart<Dim>>(*pressure));
   scheme->add(std::make_unique<StressPointHalfStep<Dim, PorePressureGradient<Dim>>>(model, sources, gradient));
-  scheme->add(std::make_unique<NodeFullStep<Dim>>(model, sources));
+  auto node_step = std::make_unique<NodeFullStep<Dim>>(model, sources);
+  node_step->record_volumetric_rate(pressure->volumetric_rate());
+  scheme->add(std::move(node_step));
   if constexpr (Dim == 2) {
     if (model.plates) scheme->add(std::make_unique<DriveRigidPlates>(model));
   }

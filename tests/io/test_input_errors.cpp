@@ -131,7 +131,8 @@ TEST(InputErrors, UnknownPressureDivergence) {
   test::TempDir dir;
   const std::string text = replace(kBase, "[time]", "[fluid]\nporosity = 0.3\ndensity = 1000.0\nbulk_modulus = 2.2e9\nconductivity = 1.0e-5\n[solver]\nversion = \"v3\"\npressure_divergence = \"elements\"\n[time]");
   const auto o = run_case_text(dir, text);
-  expect_error_at(o, line_of(text, "pressure_divergence"), "solver.pressure_divergence", {"nodes", "stress_points"});
+  expect_error_at(o, line_of(text, "pressure_divergence"), "solver.pressure_divergence",
+                  {"consistent", "nodes", "stress_points"});
 }
 
 TEST(InputErrors, IncrementalProjectionWithStressPointDivergence) {
@@ -140,6 +141,15 @@ TEST(InputErrors, IncrementalProjectionWithStressPointDivergence) {
       kBase, "[time]", "[fluid]\nporosity = 0.3\ndensity = 1000.0\nbulk_modulus = 2.2e9\nconductivity = 1.0e-5\n[solver]\nversion = \"v3\"\npressure_divergence = \"stress_points\"\npressure_incremental = true\n[time]");
   const auto o = run_case_text(dir, text);
   expect_error_at(o, line_of(text, "pressure_incremental"), "solver.pressure_incremental", {"unstable"});
+}
+
+TEST(InputErrors, ConsistentStorageRateNeedsTheIncrementalProjection) {
+  test::TempDir dir;
+  const std::string text = replace(
+      kBase, "[time]", "[fluid]\nporosity = 0.3\ndensity = 1000.0\nbulk_modulus = 2.2e9\nconductivity = 1.0e-5\n[solver]\nversion = \"v3\"\npressure_incremental = false\n[time]");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "pressure_incremental"), "solver.pressure_incremental",
+                  {"consistent", "pressure_divergence = \"nodes\""});
 }
 
 TEST(InputErrors, FreeSurfaceDetectionNeedsV2) {
