@@ -6,9 +6,10 @@
 //
 // The footing's edge node takes half the pressure (tributary average, docs/case-format.md) and
 // displacements follow the stress points' velocity (docs/method-notes.md, "Displacements"):
-// the edge no longer runs away. What is left in the drained run is a small steady pore
-// pressure fed by the O(dt) nodal velocity that the two-step scheme keeps at a load jump in a
-// steady state (method-notes §2.4 takes div v* at the nodes); see docs/VALIDATION.md, Case 15.
+// the edge no longer runs away. The storage equation takes the default, consistent rate
+// (method-notes eq. (2.4.20)): with the nodes' divergence alone, the O(dt) nodal velocity that the
+// two-step scheme keeps at a load jump in a steady state fed a steady Darcy flow and p_w never
+// drained; see docs/VALIDATION.md, Case 15.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -66,6 +67,26 @@ double checkerboard(const Simulation<2>& s, double dx) {
     worst = std::max(worst, std::abs(pw[i] - mean) / kSigma0);
   }
   return worst;
+}
+
+// The odd-even (checkerboard) amplitude of p_w / sigma0: the fourth difference along x and y
+// (saturated_common.hpp, as for Cases 16 and 17), exactly the amplitude of a node-to-node
+// alternation and zero for any cubic field, over the nodes whose five-point stencils lie in the
+// body, the drained surface nodes (p_w = 0, the boundary layer's pinned end) left out. The mean
+// of 4 neighbours above also reads the curvature of a smooth field (Delta x^2 lap p / 4), which
+// beside the footing edge is steep at t = 1.5 s: it is reported, not the criterion.
+double alternation(const Simulation<2>& s, double dx) {
+  const auto& nodes = s.nodes();
+  const auto& pw = s.node_pore_pressure();
+  std::vector<double> x(static_cast<std::size_t>(nodes.size())), y(x.size()), f(x.size());
+  std::vector<bool> drained(x.size());
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    x[i] = nodes.position[i][0];
+    y[i] = nodes.position[i][1];
+    f[i] = pw[i] / kSigma0;
+    drained[i] = std::abs(y[i] - kSurface) < 1e-6 * dx && x[i] > 3.0 + 1e-6 * dx;
+  }
+  return checkerboard_amplitude(x, y, f, dx, nullptr, &drained);
 }
 
 }  // namespace
@@ -130,8 +151,13 @@ CaseReport validate_case15(const Options& opt, const std::string& dir) {
     rep.metrics.push_back(metric(fmt::format("undrained, dx = {}: centre settlement relative error (FE 4.56e-4 m)", dx),
                                  std::abs(s - kUndrainedSettlement) / kUndrainedSettlement, "<=", 0.10, ""));
     rep.metrics.push_back(
-        metric(fmt::format("undrained, dx = {}: checkerboard max|p_I - mean of 4 neighbours| / sigma0 at 1.5 s", dx),
-               checkerboard(solver, dx), "<=", 0.01, ""));
+        metric(fmt::format("undrained, dx = {}: checkerboard (max alternating p_w component / sigma0) at 1.5 s", dx),
+               alternation(solver, dx), "<=", 0.01, ""));
+    rep.metrics.push_back(metric(
+        fmt::format("undrained, dx = {}: max|p_I - mean of 4 neighbours| / sigma0 at 1.5 s, > 3 dx from the faces "
+                    "(curvature included)",
+                    dx),
+        checkerboard(solver, dx), "", 0.0, ""));
   }
 
   // ---- drained end state (k = 1e-3 m/s, 130 s)
@@ -143,7 +169,7 @@ CaseReport validate_case15(const Options& opt, const std::string& dir) {
     const std::size_t centre = nearest(nodes, 0.0, kSurface), edge = nearest(nodes, 3.0, kSurface);
     std::ofstream hist(fmt::format("{}/consolidation_dx{}.csv", dir, dx));
     hist << "t,centre_settlement,edge_settlement,max_pw\n";
-    double last = 0.0, drop = 0.0, checker = 0.0;
+    double last = 0.0, drop = 0.0, checker = 0.0, checker_mean4 = 0.0;
     // 1 s window means of the centre settlement (the raw signal carries the column's undrained
     // vibration) and the vibration's amplitude in the window 2-3 s.
     std::vector<double> window_sum(131, 0.0), window_count(131, 0.0);
@@ -167,8 +193,10 @@ CaseReport validate_case15(const Options& opt, const std::string& dir) {
         vib_hi = std::max(vib_hi, sc);
       }
       last = sc;
-      if (std::abs(solver.time() - 15.0) < 0.5 * static_cast<double>(every) * solver.dt())
-        checker = checkerboard(solver, dx);
+      if (std::abs(solver.time() - 15.0) < 0.5 * static_cast<double>(every) * solver.dt()) {
+        checker = alternation(solver, dx);
+        checker_mean4 = checkerboard(solver, dx);
+      }
     }
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     double pmax = 0.0;
@@ -205,8 +233,11 @@ CaseReport validate_case15(const Options& opt, const std::string& dir) {
                                              dx),
                                  window_drop / sc, "", 0.0, ""));
     rep.metrics.push_back(
-        metric(fmt::format("drained, dx = {}: checkerboard max|p_I - mean of 4 neighbours| / sigma0 at 15 s", dx),
+        metric(fmt::format("drained, dx = {}: checkerboard (max alternating p_w component / sigma0) at 15 s", dx),
                checker, "<=", 0.01, ""));
+    rep.metrics.push_back(
+        metric(fmt::format("drained, dx = {}: max|p_I - mean of 4 neighbours| / sigma0 at 15 s (curvature included)", dx),
+               checker_mean4, "", 0.0, ""));
     const PressureSolveStats* ps = &pressure_stage(solver, "case 15").stats();
     if (ps == nullptr) throw SolverError("case 15 is not a V3 case");
     rep.notes.push_back(
