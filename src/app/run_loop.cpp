@@ -493,6 +493,9 @@ int run_loop(const LoopInput& in) {
                              : setup.fluid.incomplete_cholesky ? "incomplete_cholesky"
                                                                : "jacobi"},
           {"method", pressure->implicit_faces() ? "bicgstab" : "conjugate_gradient"},
+          {"storage_rate", setup.fluid.storage_rate == FluidSpec::StorageRate::consistent ? "consistent"
+                           : setup.fluid.storage_rate == FluidSpec::StorageRate::nodes ? "nodes"
+                                                                                       : "stress_points"},
           {"implicit_face_nodes", pressure->implicit_faces() ? pressure->impermeable_stress_face_nodes() : 0},
           {"undrained_courant", pressure->undrained_courant()},
           {"filter_quadratic_fit_nodes", pressure->filter_fitted_rows()},
