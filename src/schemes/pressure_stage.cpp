@@ -87,9 +87,6 @@ PorePressureStage<Dim>::PorePressureStage(StaggeredModel<Dim>& model) : m_(model
   if (fl.storage_rate == StorageRate::consistent) {
     volumetric_rate_.assign(nn, 0.0);
     previous_divergence_.assign(nn, 0.0);
-    // Measured: the explicit face condition is stable up to C c_u/c_d = 2.4-2.5, not at 2.6-2.7.
-    explicit_limit_ = 2.5;
-    auto_threshold_ = 2.0;
   }
   s.k_eff = fl.permeability() + fl.saturation * stabilisation_time_ / rho;
   s.tolerance = fl.tolerance;
@@ -292,29 +289,40 @@ void PorePressureStage<Dim>::solve_with_bodies() {
 }
 
 template <int Dim>
-void PorePressureStage<Dim>::record_initial_divergence() {
-  if (previous_divergence_.empty() || previous_divergence_valid_) return;
-  const auto v = std::as_const(m_.nodes).view(m_.fields.velocity);
+template <class Use>
+void PorePressureStage<Dim>::each_node_divergence(const double* field, Use&& use) const {
   const CorrectedOperator<Dim>& op = node_operator_;
-  exec::particle_for(m_.policy, m_.nodes.size(), [&](Index i) {
-    double div = 0.0;
-    const auto r = op.row(i);
-    for (Index k = r.begin; k < r.end; ++k) {
-      const double* vj = v[op.source(r, k)];
-      for (int d = 0; d < Dim; ++d) div += op.grad[static_cast<std::size_t>(k)][static_cast<std::size_t>(d)] * vj[d];
-    }
-    previous_divergence_[static_cast<std::size_t>(i)] = div;
-  });
+  exec::particle_for(
+      m_.policy, op.runs(),
+      [&](Index r) {
+        double acc[Dim][CorrectedOperator<Dim>::kMaxRun * Dim];
+        gradient_run<Dim, Dim>(op, field, r, acc);
+        const Index i0 = op.run_start[static_cast<std::size_t>(r)];
+        for (Index i = i0; i < op.run_start[static_cast<std::size_t>(r) + 1]; ++i) {
+          double div = 0.0;
+          for (int d = 0; d < Dim; ++d) div += acc[d][static_cast<std::size_t>(i - i0) * Dim + static_cast<std::size_t>(d)];
+          use(i, div);
+        }
+      },
+      exec::Schedule::even, m_.nodes.size());
+}
+
+template <int Dim>
+void PorePressureStage<Dim>::record_node_divergence(bool initial_only) {
+  if (previous_divergence_.empty() || (initial_only && previous_divergence_valid_)) return;
+  each_node_divergence(std::as_const(m_.nodes).view(m_.fields.velocity).data(),
+                       [&](Index i, double div) { previous_divergence_[static_cast<std::size_t>(i)] = div; });
   previous_divergence_valid_ = true;
 }
 
 template <int Dim>
 std::string PorePressureStage<Dim>::instability_hint() const {
-  if (impermeable_stress_faces_ == 0 || undrained_courant_ <= explicit_limit_ || implicit_faces()) return {};
+  const double limit = undrained_courant_limit();
+  if (impermeable_stress_faces_ == 0 || undrained_courant_ <= limit || implicit_faces()) return {};
   return fmt::format(
       " (V3: impermeable faces carrying a total stress are unstable above C c_u/c_d = {}; "
       "here it is {:.2f}: time.cfl <= {:.3f})",
-      explicit_limit_, undrained_courant_, m_.time_step.courant * explicit_limit_ / undrained_courant_);
+      limit, undrained_courant_, m_.time_step.courant * limit / undrained_courant_);
 }
 
 template <int Dim>
@@ -402,23 +410,8 @@ void PorePressureStage<Dim>::run(const StepContext& context) {
     source_[iu] = pw_old[iu] * inv_q_dt - sw * div;
     if (conditions_.drained[iu]) pw[iu] = conditions_.value[iu] * m_.function_value(conditions_.function[iu], t_new);
   };
-  // The node operator's divergence of a field of Dim values, or gradient of a scalar, at every
-  // node, summed over runs of rows (operators/run_sums.hpp), handed to `use` row by row.
-  auto each_divergence = [&](const double* field, auto&& use) {
-    exec::particle_for(
-        m_.policy, op.runs(),
-        [&](Index r) {
-          double acc[Dim][CorrectedOperator<Dim>::kMaxRun * Dim];
-          gradient_run<Dim, Dim>(op, field, r, acc);
-          const Index i0 = op.run_start[static_cast<std::size_t>(r)];
-          for (Index i = i0; i < op.run_start[static_cast<std::size_t>(r) + 1]; ++i) {
-            double div = 0.0;
-            for (int d = 0; d < Dim; ++d) div += acc[d][static_cast<std::size_t>(i - i0) * Dim + static_cast<std::size_t>(d)];
-            use(i, div);
-          }
-        },
-        exec::Schedule::even, nn);
-  };
+  // The node operator's gradient of a scalar at every node, summed over runs of rows
+  // (operators/run_sums.hpp), handed to `use` row by row (each_node_divergence likewise).
   auto each_gradient = [&](const double* field, auto&& use) {
     exec::particle_for(
         m_.policy, op.runs(),
@@ -446,7 +439,7 @@ void PorePressureStage<Dim>::run(const StepContext& context) {
       source_at(i, div);
     });
   } else {
-    each_divergence(v.data(), source_at);
+    each_node_divergence(v.data(), source_at);
   }
   if (!pressure_gradient_.empty()) {
     // Incremental projection (solver.pressure_incremental): add S_w dt div(grad p^n / rho) to the
@@ -467,7 +460,7 @@ void PorePressureStage<Dim>::run(const StepContext& context) {
         if (c.component < Dim) grad(i, c.component) = 0.0;
       }
     }
-    each_divergence(grad.data(), [&](Index i, double div) {
+    each_node_divergence(grad.data(), [&](Index i, double div) {
       source_[static_cast<std::size_t>(i)] += sw * stabilisation_time_ * div;
     });
   }
@@ -477,8 +470,8 @@ void PorePressureStage<Dim>::run(const StepContext& context) {
     // integrates), so that the equation reads that rate plus the change of the node divergence
     // over the step, D v^{n+1} - D v^n, whose D v^{n+1} is the implicit part above. In a steady
     // state the nodes' O(dt) velocity that no stress point sees then cancels (Case 15: p_w drains
-    // under the footing edge). D v^0 is the initial velocity's (record_initial_divergence), so
-    // that the nodal terms telescope from the start.
+    // under the footing edge). D v^n is recorded by RecordNodeDivergence (D v^0 from the initial
+    // velocity, so that the nodal terms telescope from the start).
     const double* rate = volumetric_rate_.data();
     const double* previous = previous_divergence_.data();
     exec::particle_for(m_.policy, nn, [&](Index i) {
@@ -513,13 +506,6 @@ void PorePressureStage<Dim>::run(const StepContext& context) {
   });
   // The face condition at t^{n+1}: v += B (p^{n+1} - p^n) (method-notes eq. (2.4.16)).
   if (!face_coupling_.empty()) face_coupling_.add_velocity(v, pw, pw_old.data());
-  if (!previous_divergence_.empty()) {
-    // D v^{n+1} for the next step, with the prescribed components at t^{n+1} as the next step's
-    // v* has them (the constraint stage that follows does the same again: it is idempotent).
-    m_.apply_constraints(t_new);
-    each_divergence(v.data(), [&](Index i, double div) { previous_divergence_[static_cast<std::size_t>(i)] = div; });
-    previous_divergence_valid_ = true;
-  }
   seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 

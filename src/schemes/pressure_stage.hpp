@@ -40,9 +40,11 @@ class PorePressureStage final : public Stage {
   /// Where step 2 writes tr d^{n+1/2} per node (solver.pressure_divergence = "consistent",
   /// method-notes eq. (2.4.20)); null otherwise.
   double* volumetric_rate() { return volumetric_rate_.empty() ? nullptr : volumetric_rate_.data(); }
-  /// D v^0 for the consistent storage rate, from the nodal velocity as it is before the first
-  /// step (StorageRateStart runs it); nothing once known (a later step, or a resumed run).
-  void record_initial_divergence();
+  /// D v for the consistent storage rate (method-notes eq. (2.4.20)), from the nodal velocity
+  /// as it is now; RecordNodeDivergence runs it before the first step (D v^0; with `initial_only`
+  /// nothing once known, e.g. in a resumed run) and after the constraints that follow this stage
+  /// (D v^{n+1}, before the velocity filter).
+  void record_node_divergence(bool initial_only);
   /// 1/Q*, 1/Pa.
   double inverse_storage() const { return inv_storage_; }
 
@@ -67,10 +69,10 @@ class PorePressureStage final : public Stage {
   /// "nodes" or "stress_points" (stable at 2.7, 2.9, 3.4; unstable at 3.6), 2.5 with
   /// "consistent" (stable at 2.41 / 2.53, unstable at 2.56 / 2.68 on a 2D sample / 1D column:
   /// docs/VALIDATION.md).
-  double undrained_courant_limit() const { return explicit_limit_; }
+  double undrained_courant_limit() const { return consistent() ? 2.5 : 3.5; }
   /// solver.pressure_faces = "auto" takes the faces implicitly above this C c_u/c_d, a margin
   /// below the limit: 2.5 ("nodes"), 2.0 ("consistent").
-  double auto_implicit_courant() const { return auto_threshold_; }
+  double auto_implicit_courant() const { return consistent() ? 2.0 : 2.5; }
   /// The growth guard's hint when the limit above is exceeded (empty otherwise).
   std::string instability_hint() const;
 
@@ -107,26 +109,33 @@ class PorePressureStage final : public Stage {
   std::vector<double> body_dv_, body_w_;  // per coupling, scratch of the step
   void couple_bodies();
   void solve_with_bodies();
+  bool consistent() const { return m_.setup.fluid.storage_rate == FluidSpec::StorageRate::consistent; }
+  /// The node operator's divergence of a field of Dim values per node, summed over runs of rows
+  /// (operators/run_sums.hpp), handed to use(i, div) node by node.
+  template <class Use>
+  void each_node_divergence(const double* field, Use&& use) const;
   double inv_storage_ = 0.0;
   double stabilisation_time_ = 0.0;  // dt (method-notes §2.4) or dt/2 ("stress_points")
   double undrained_courant_ = 0.0;
-  double explicit_limit_ = 3.5, auto_threshold_ = 2.5;
   Index impermeable_stress_faces_ = 0;
   Index filter_fitted_rows_ = 0;
   double seconds_ = 0.0;
 };
 
-/// First stage of V3 with the consistent storage rate: the initial nodal divergence D v^0 of
-/// method-notes eq. (2.4.20), taken before step 1 changes the velocity.
+/// V3 with the consistent storage rate: the nodal divergence D v of method-notes eq. (2.4.20),
+/// before the first step (initial_only: D v^0) and after the constraints that follow the
+/// pressure stage (D v^{n+1} for the next step).
 template <int Dim>
-class StorageRateStart final : public Stage {
+class RecordNodeDivergence final : public Stage {
  public:
-  explicit StorageRateStart(PorePressureStage<Dim>& pressure) : pressure_(pressure) {}
-  std::string_view name() const override { return "storage_rate_start"; }
-  void run(const StepContext& /*context*/) override { pressure_.record_initial_divergence(); }
+  RecordNodeDivergence(PorePressureStage<Dim>& pressure, bool initial_only)
+      : pressure_(pressure), initial_only_(initial_only) {}
+  std::string_view name() const override { return initial_only_ ? "storage_rate_start" : "storage_rate_record"; }
+  void run(const StepContext& /*context*/) override { pressure_.record_node_divergence(initial_only_); }
 
  private:
   PorePressureStage<Dim>& pressure_;
+  bool initial_only_;
 };
 
 }  // namespace rktsph

@@ -5,7 +5,8 @@
 //   2. nodes: v*, sigma' (effective stress), displacement (and tr d, for the storage equation)
 //   3. prescribed components (total stresses: sigma' = sigma + p_w)
 //   4. pressure: the storage equation by PCG, v^{n+1} = v* - (dt/rho) grad p^{n+1}
-//   5. prescribed components; the velocity filter and the prescribed components again.
+//   5. prescribed components (then, consistent storage rate, D v^{n+1}); the velocity filter and
+//      the prescribed components again.
 // With rigid bodies (2D, method-notes §4.6): their velocities at t^{n+1} before 3 without the
 // pore pressure, whose part the pressure stage adds (implicit); offsets and reactions last.
 #include <memory>
@@ -25,7 +26,8 @@ std::unique_ptr<Scheme> make_v3_scheme(StaggeredModel<Dim>& model) {
   gradient.pressure = model.nodes.view(pressure->pore_pressure()).data();
   gradient.skeleton = pressure->skeleton_velocity();
   auto sources = std::make_shared<ViscoplasticSources<Dim>>(model);
-  if (pressure->volumetric_rate() != nullptr) scheme->add(std::make_unique<StorageRateStart<Dim>>(*pressure));
+  const bool consistent = pressure->volumetric_rate() != nullptr;
+  if (consistent) scheme->add(std::make_unique<RecordNodeDivergence<Dim>>(*pressure, true));
   scheme->add(std::make_unique<StressPointHalfStep<Dim, PorePressureGradient<Dim>>>(model, sources, gradient));
   auto node_step = std::make_unique<NodeFullStep<Dim>>(model, sources);
   node_step->record_volumetric_rate(pressure->volumetric_rate());
@@ -36,6 +38,7 @@ std::unique_ptr<Scheme> make_v3_scheme(StaggeredModel<Dim>& model) {
   scheme->add(std::make_unique<ApplyConstraints<Dim>>(model));
   PorePressureStage<Dim>& stage = scheme->add(std::move(pressure));
   scheme->add(std::make_unique<ApplyConstraints<Dim>>(model));
+  if (consistent) scheme->add(std::make_unique<RecordNodeDivergence<Dim>>(stage, false));
   if (model.setup.filter) {
     scheme->add(std::make_unique<VelocityFilter<Dim>>(model, model.setup.filter_strength));
     scheme->add(std::make_unique<ApplyConstraints<Dim>>(model));

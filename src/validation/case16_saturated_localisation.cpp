@@ -118,11 +118,17 @@ SatRun run_sample(const std::string& case_file, double dx, double k, double end_
   const auto& nodes = solver.nodes();
   const auto nn = static_cast<std::size_t>(nodes.size());
   const HistoryView eps_of = node_history(solver, "eps_vp_eq", "case 16");
-  std::vector<bool> seed(nn, false);
-  for (std::size_t m = 0; m < setup.material_names.size(); ++m) {
-    if (setup.material_names[m] != "weak") continue;
-    for (std::size_t i = 0; i < nn; ++i) seed[i] = nodes.material[i] == static_cast<int>(m);
+  // The seed: nodes of a material other than the sample's (the most common one).
+  std::vector<std::size_t> per_material;
+  for (std::size_t i = 0; i < nn; ++i) {
+    const auto m = static_cast<std::size_t>(nodes.material[i]);
+    if (m >= per_material.size()) per_material.resize(m + 1, 0);
+    ++per_material[m];
   }
+  const auto sample_material =
+      static_cast<int>(std::max_element(per_material.begin(), per_material.end()) - per_material.begin());
+  std::vector<bool> seed(nn, false);
+  for (std::size_t i = 0; i < nn; ++i) seed[i] = nodes.material[i] != sample_material;
   auto q_of = [&](std::size_t i) { return solver.node_stress().invariants(i).q; };
   double volume = 0.0;
   for (std::size_t i = 0; i < nn; ++i) volume += nodes.volume[i];
@@ -248,24 +254,15 @@ SatRun run_sample(const std::string& case_file, double dx, double k, double end_
     }
     // p_w in the band cloud against the zone around it: the nodes outside the cloud within
     // 0.2 m (about twice the band width of docs/cases.md) of a cloud node, off the platen margins.
-    // The seed: nodes of a material other than the sample's (the most common one).
-    std::vector<std::size_t> per_material;
-    for (std::size_t i = 0; i < nn; ++i) {
-      const auto m = static_cast<std::size_t>(nodes.material[i]);
-      if (m >= per_material.size()) per_material.resize(m + 1, 0);
-      ++per_material[m];
-    }
-    const auto sample_material =
-        static_cast<int>(std::max_element(per_material.begin(), per_material.end()) - per_material.begin());
     for (const bool skip_seed : {false, true}) {
       double sb = 0.0, sa = 0.0;
       int nb = 0, na = 0;
       std::vector<std::size_t> cloud;
       for (std::size_t i = 0; i < nn; ++i) {
-        if (out.band.in_band[i] && !(skip_seed && nodes.material[i] != sample_material)) cloud.push_back(i);
+        if (out.band.in_band[i] && !(skip_seed && seed[i])) cloud.push_back(i);
       }
       for (std::size_t i = 0; i < nn; ++i) {
-        if (skip_seed && nodes.material[i] != sample_material) continue;
+        if (skip_seed && seed[i]) continue;
         if (out.band.in_band[i]) {
           sb += s.pw[i];
           ++nb;
