@@ -13,6 +13,7 @@
 #   scripts/validate_variant.sh --only '1[3-7]_*' /tmp/half solver.pressure_odd_even_filter=0.5 -- 13 14 15 16 17
 #   scripts/validate_variant.sh --only '16_*' /tmp/c05 time.cfl=0.5 -- --full 16
 set -eu
+# RKTSPH names the binary (default build/rktsph), e.g. a copy kept while build/ is rebuilt.
 cd "$(dirname "$0")/.."
 only='*'
 if [ "${1:-}" = "--only" ]; then
@@ -51,4 +52,4 @@ while [ $# -gt 0 ] && [ "$1" != "--" ]; do
   shift
 done
 [ "${1:-}" = "--" ] && shift
-exec build/rktsph validate --no-plots --cases-dir "$out/cases/thesis" -o "$out/report" "$@"
+exec "${RKTSPH:-build/rktsph}" validate --no-plots --cases-dir "$out/cases/thesis" -o "$out/report" "$@"

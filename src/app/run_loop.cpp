@@ -113,6 +113,7 @@ int run_loop(const LoopInput& in) {
   struct Probe {
     std::string name;
     Index node;
+    std::int64_t id;  // the node's global id: V2 reorders its nodes, the probe follows the id
     std::vector<std::pair<std::string, io::ScalarField>> fields;
   };
   std::vector<Probe> probes;
@@ -133,7 +134,7 @@ int run_loop(const LoopInput& in) {
       throw InputError(fmt::format("{}: probe '{}' at [{}] lies outside the body (nearest node is {:.4g} m away)",
                                    spec.where, spec.name, fmt::join(spec.position, ", "), best_d));
     }
-    Probe p{spec.name, best, {}};
+    Probe p{spec.name, best, nodes.global_id[static_cast<std::size_t>(best)], {}};
     for (const auto& f : spec.fields) {
       auto value = node_fields.scalar(f);
       if (!value) {
@@ -339,7 +340,14 @@ int run_loop(const LoopInput& in) {
     probe_csv.append(header + "\n");
     energy_csv.append("t,kinetic,strain,external_work,damping_loss,imbalance\n");
   }
+  long probes_reorders = 0;
   auto record_probes = [&] {
+    if (solver.reorders() != probes_reorders) {
+      // The nodes were reordered (sorted by cell): find each probe's node again by its id.
+      const auto& ids = solver.nodes().global_id;
+      for (auto& p : probes) p.node = static_cast<Index>(std::find(ids.begin(), ids.end(), p.id) - ids.begin());
+      probes_reorders = solver.reorders();
+    }
     std::string row = fmt::format("{:.10g}", solver.time());
     for (const auto& p : probes) {
       for (const auto& [fname, value] : p.fields) row += fmt::format(",{:.10g}", value(p.node));

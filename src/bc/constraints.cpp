@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "core/error.hpp"
+#include "particles/permutation.hpp"
 
 namespace rktsph {
 
@@ -211,6 +212,31 @@ void NodalConstraints<Dim>::resolve(const std::vector<BoundarySpec<Dim>>& specs,
       constrained_.push_back(static_cast<Index>(i));
     }
   }
+}
+
+template <int Dim>
+void NodalConstraints<Dim>::remap(const std::vector<Index>& order) {
+  const std::size_t nn = order.size();
+  if (row_.size() != nn + 1) throw SolverError("nodal constraints: a reordering of the wrong size");
+  const std::vector<Index> new_index = inverse_order(order);
+  std::vector<Index> row(nn + 1, 0);
+  std::vector<NodalConstraint> list;
+  list.reserve(list_.size());
+  constrained_.clear();
+  for (std::size_t k = 0; k < nn; ++k) {
+    const auto i = static_cast<std::size_t>(order[k]);
+    list.insert(list.end(), list_.begin() + row_[i], list_.begin() + row_[i + 1]);
+    row[k + 1] = static_cast<Index>(list.size());
+    constrained_row_[k] = -1;
+    if (row[k + 1] > row[k]) {
+      constrained_row_[k] = static_cast<Index>(constrained_.size());
+      constrained_.push_back(static_cast<Index>(k));
+    }
+  }
+  row_ = std::move(row);
+  list_ = std::move(list);
+  // The rotated faces keep their rows (surface rows refer to them by position).
+  renumber(rotated_, new_index);
 }
 
 template class NodalConstraints<1>;

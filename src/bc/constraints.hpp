@@ -3,8 +3,8 @@
 // case (regions with a velocity, a stress or both, scaled by a time function) and the
 // traction-free default on every face of the body, resolved to per-node constraints.
 //
-// The resolution runs again whenever the nodes have been reordered or have moved (resolve()):
-// a constraint is stored by node index, which is only valid for one ordering.
+// A constraint is stored by node index, valid for one ordering: remap() follows a reordering of
+// the nodes (V2 sorts them by cell), and resolve() runs on the nodes as made.
 #include <cstdint>
 #include <vector>
 
@@ -35,6 +35,11 @@ class NodalConstraints {
   /// detection (V2).
   void resolve(const std::vector<BoundarySpec<Dim>>& specs, const ParticleSet<Dim>& nodes,
                const BoundaryNodes<Dim>& boundary, double dx, bool free_faces = true);
+
+  /// Follow ParticleSet::permute(order) of the nodes (node order[k] is now node k): V2 sorts
+  /// its moving nodes, whose constraints were resolved on the positions as made and cannot be
+  /// resolved again on the moved ones. constrained() stays ascending.
+  void remap(const std::vector<Index>& order);
 
   /// The face nodes of polygon bodies made traction-free by rotation to their local frame
   /// (method-notes §3.7, §3.9): sigma.n = 0 about rotated_normals()[k] at node rotated()[k], or

@@ -6,6 +6,7 @@
 #include <utility>
 
 #include "io/state_archive.hpp"
+#include "particles/permutation.hpp"
 
 namespace rktsph {
 
@@ -415,6 +416,20 @@ int RigidContact::faces_body(const Vec<2>& x, const Vec<2>& n_out, double range)
     if (gap.within && gap.g > keep_ && gap.g <= range && -n_out.dot(gap.normal) > kCos45) return static_cast<int>(b);
   }
   return -1;
+}
+
+void RigidContact::reorder_nodes(const std::vector<Index>& order) {
+  const auto slots = static_cast<std::size_t>(kMaxContacts);
+  permute_rows(body_, order, slots);
+  permute_rows(previous_body_, order, slots);
+  permute_rows(slip_, order, slots);
+  permute_rows(previous_slip_, order, slots);
+  permute_rows(normal_, order, slots);
+  permute_rows(release_snn_, order, slots);
+  permute_rows(in_contact_, order);
+  permute_rows(x_begin_, order);
+  const std::vector<Index> new_index = inverse_order(order);
+  for (ContactPoint& p : profile_) p.node = new_index[static_cast<std::size_t>(p.node)];
 }
 
 void RigidContact::save(io::StateArchive& a, const std::string& prefix) const {

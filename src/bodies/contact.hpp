@@ -106,6 +106,10 @@ class RigidContact {
   /// empty).
   bool inside(const Vec<2>& x) const;
 
+  /// Follow a reordering of the nodes (node order[k] is now node k): the per-node slots move
+  /// with their nodes.
+  void reorder_nodes(const std::vector<Index>& order);
+
   void save(io::StateArchive& archive, const std::string& prefix) const;
   void load(const io::StateArchive& archive, const std::string& prefix);
 

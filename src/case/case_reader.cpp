@@ -388,6 +388,19 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     c.shift_distance = s->number("shift_distance", 0.5);
     s->require(c.shift_distance > 0.0 && c.shift_distance <= 1.0, "shift_distance",
                fmt::format("must lie in (0, 1] (a multiple of dx), got {}", c.shift_distance));
+    const std::string sort = s->string("sort", "morton");
+    if (sort == "morton") {
+      c.sort_particles = true;
+    } else if (sort == "off") {
+      c.sort_particles = false;
+    } else {
+      s->fail("sort", fmt::format("unknown value '{}' (known: morton, off)", sort));
+    }
+    if (s->has("sort")) {
+      s->require(c.version == "v2", "sort",
+                 "sorting the particles needs solver.version = \"v2\" (fixed particles keep the lattice's order, "
+                 "which their operators' shared rows rely on)");
+    }
     if (s->has("domain_min") || s->has("domain_max")) {
       if (!s->has("domain_min")) s->fail("domain_max", "needs solver.domain_min as well (the box's lower corner)");
       if (!s->has("domain_max")) s->fail("domain_min", "needs solver.domain_max as well (the box's upper corner)");

@@ -269,6 +269,9 @@ struct CaseSetup {
   long shift_interval = 20;
   double shift_strength = 0.01;
   double shift_distance = 0.5;
+  /// V2: the particle sets stored in Morton order of their cells, sorted again at every
+  /// neighbour search (method-notes §3.8, "Storage order"; solver.sort = "morton" | "off").
+  bool sort_particles = true;
   /// V2: the domain box [min, max] (solver.domain_min / domain_max): particles that leave it
   /// are deactivated (schemes/deactivate_stage.hpp); empty: no box. `domain_where` names the
   /// keys' file and line for the errors found once the particles exist.

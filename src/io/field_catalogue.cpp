@@ -74,6 +74,10 @@ FieldCatalogue<Dim>::FieldCatalogue(const Simulation<Dim>& sim, Set set) {
   if (sim.setup().version == "v2") {
     const std::vector<double>* density = &particles.density;
     scalar("density", [density](Index i) { return (*density)[static_cast<std::size_t>(i)]; });
+    // The particle's global id: V2 stores its particles sorted by cell and sorts them again as
+    // they move, so a particle is followed from frame to frame by its id, not its place.
+    const std::vector<std::int64_t>* ids = &particles.global_id;
+    scalar("id", [ids](Index i) { return static_cast<double>((*ids)[static_cast<std::size_t>(i)]); });
   }
   const std::vector<int>* material = &particles.material;
   fields_.push_back({"material", 1, [material](Index i, int) { return (*material)[static_cast<std::size_t>(i)]; }});

@@ -5,8 +5,8 @@
 // Every set has mutable positions, volumes, densities, materials and global ids, and holds
 // the fields its schemes register by name (particles/field.hpp), one array per field. The
 // first owned() particles belong to this process; the rest, [owned(), size()), is room for
-// ghost copies of other processes' particles (a halo; none yet). Reordering (sorting by cell,
-// later) goes through permute(), which carries every property and field.
+// ghost copies of other processes' particles (a halo; none yet). Reordering (V2 sorts its sets
+// by cell, neighbours/morton.hpp) goes through permute(), which carries every property and field.
 #include <algorithm>
 #include <cstdint>
 #include <numeric>
@@ -20,6 +20,7 @@
 #include "core/error.hpp"
 #include "core/types.hpp"
 #include "particles/field.hpp"
+#include "particles/permutation.hpp"
 
 namespace rktsph {
 
@@ -166,23 +167,29 @@ class ParticleSet {
     for (const Column& c : columns_) {
       if ((c.info.flags & flags) != 0 || (c.info.flags == 0 && flags == ~0u)) b += c.bytes();
     }
+    if (flags == ~0u) {  // the work space of permute()
+      b += scratch_.vec.capacity() * sizeof(Vec<Dim>) + scratch_.f64.capacity() * sizeof(double) +
+           scratch_.u8.capacity() + scratch_.i64.capacity() * sizeof(std::int64_t) + scratch_.i32.capacity() * sizeof(int);
+    }
     return b;
   }
 
   /// Reorder: particle k of the result is particle order[k] of this set (a permutation of
-  /// [0, size())). Every property and field moves with its particle.
+  /// [0, size())). Every property and field moves with its particle, in place: views and
+  /// pointers into the arrays stay valid. The work space is kept, so a set sorted again and
+  /// again (V2, at every neighbour search) allocates nothing after the first time.
   void permute(const std::vector<Index>& order) {
     if (order.size() != position.size()) throw SolverError(fmt::format("{}: permutation of the wrong size", name_));
-    apply(position, order);
-    apply(volume, order);
-    apply(density, order);
-    apply(material, order);
-    apply(global_id, order);
+    permute_rows(position, order, 1, scratch_.vec);
+    permute_rows(volume, order, 1, scratch_.f64);
+    permute_rows(density, order, 1, scratch_.f64);
+    permute_rows(material, order, 1, scratch_.i32);
+    permute_rows(global_id, order, 1, scratch_.i64);
     for (Column& c : columns_) {
       const auto n = static_cast<std::size_t>(c.info.components);
-      apply_rows(c.f64, order, n);
-      apply_rows(c.u8, order, n);
-      apply_rows(c.i64, order, n);
+      permute_rows(c.f64, order, n, scratch_.f64);
+      permute_rows(c.u8, order, n, scratch_.u8);
+      permute_rows(c.i64, order, n, scratch_.i64);
     }
   }
 
@@ -232,28 +239,17 @@ class ParticleSet {
   }
   const Column& column(int id) const { return const_cast<ParticleSet*>(this)->column(id); }
 
-  template <class V>
-  static void apply(V& values, const std::vector<Index>& order) {
-    if (values.empty()) return;
-    V out(values.size());
-    for (std::size_t k = 0; k < order.size(); ++k) out[k] = values[static_cast<std::size_t>(order[k])];
-    values = std::move(out);
-  }
-  template <class V>
-  static void apply_rows(V& values, const std::vector<Index>& order, std::size_t n) {
-    if (values.empty()) return;
-    V out(values.size());
-    for (std::size_t k = 0; k < order.size(); ++k) {
-      std::copy_n(values.begin() + static_cast<std::ptrdiff_t>(static_cast<std::size_t>(order[k]) * n), n,
-                  out.begin() + static_cast<std::ptrdiff_t>(k * n));
-    }
-    values = std::move(out);
-  }
-
   std::string name_;
   Index owned_ = 0;
   std::int64_t replacements_ = 0;
   std::vector<Column> columns_;
+  struct Scratch {
+    std::vector<Vec<Dim>> vec;
+    std::vector<double> f64;
+    std::vector<std::uint8_t> u8;
+    std::vector<std::int64_t> i64;
+    std::vector<int> i32;
+  } scratch_;
 };
 
 }  // namespace rktsph

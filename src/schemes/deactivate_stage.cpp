@@ -137,6 +137,17 @@ void DeactivateOutside<Dim>::load(const io::StateArchive& a, const std::string& 
   mark_active(m_.stress_points, active_stress_points_, stress_points_);
 }
 
+template <int Dim>
+void DeactivateOutside<Dim>::reordered(const Reordering& r) {
+  const std::pair<const std::vector<Index>*, std::vector<Frozen>*> sets[] = {{&r.nodes, &nodes_},
+                                                                              {&r.stress_points, &stress_points_}};
+  for (const auto& [order, frozen] : sets) {
+    if (order->empty()) continue;
+    const std::vector<Index> new_index = inverse_order(*order);
+    for (Frozen& f : *frozen) f.index = new_index[static_cast<std::size_t>(f.index)];
+  }
+}
+
 template class DeactivateOutside<1>;
 template class DeactivateOutside<2>;
 template class DeactivateOutside<3>;

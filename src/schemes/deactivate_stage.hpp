@@ -4,7 +4,8 @@
 // a step is frozen where it was found: its volume (and so its mass) set to zero, so that it
 // takes no part in any other particle's sums, its velocity and stress to zero, and it is put
 // back at that place after every later step. It stays in the sets (and in the VTU output,
-// field `active` = 0) so that indices, probes and checkpoints keep their meaning. The count and
+// field `active` = 0) so that probes and checkpoints keep their meaning; its index follows
+// any reordering of the sets. The count and
 // the mass removed are reported (summary.json, particles.csv), so that the mass balance still
 // closes: the particles' mass plus the deactivated mass is the initial mass.
 #include <cstdint>
@@ -31,6 +32,7 @@ class DeactivateOutside final : public Stage {
   }
   void save(io::StateArchive& archive, const std::string& prefix) const override;
   void load(const io::StateArchive& archive, const std::string& prefix) override;
+  void reordered(const Reordering& reordering) override;
   std::vector<std::pair<std::string, double>> report() const override {
     return {{"deactivated_nodes", static_cast<double>(nodes_.size())},
             {"deactivated_stress_points", static_cast<double>(stress_points_deactivated_)},

@@ -41,6 +41,11 @@ class Scheme {
     for (auto& s : stages_) s->run(context);
   }
 
+  /// Tell every stage that the particle sets were reordered (Stage::reordered).
+  void reordered(const Reordering& reordering) {
+    for (auto& s : stages_) s->reordered(reordering);
+  }
+
   std::size_t scratch_bytes() const {
     std::size_t b = 0;
     for (const auto& s : stages_) b += s->scratch_bytes();

@@ -1,4 +1,5 @@
 #pragma once
+#include <algorithm>
 // A run of a case: the model (particles, operators, constraints), the scheme made for it by
 // name (schemes/registry.hpp) and the time control. step() is the algorithm of one time step
 // as written in method-notes §5: the scheme's stages in order, then the step's balance
@@ -69,6 +70,20 @@ class Simulation {
     return m;
   }
 
+  /// Reorder the particle sets with every table the model and the stages keep by particle
+  /// index (StaggeredModel::reorder, Stage::reordered): what V2's sort and a resume do.
+  void reorder(const Reordering& reordering) {
+    model_->reorder(reordering);
+    scheme_->reordered(reordering);
+  }
+  /// How many reorderings of the particles so far (V2 sorts them by cell, method-notes §3.8):
+  /// an index taken before one no longer names the same particle; a global id does.
+  long reorders() const { return model_->reorders(); }
+  /// The indices of the nodes in increasing global id: the order the case made them in (before
+  /// any reordering), for comparisons across time by particle.
+  std::vector<Index> nodes_by_id() const { return by_id(nodes().global_id); }
+  std::vector<Index> stress_points_by_id() const { return by_id(stress_points().global_id); }
+
   // Typed views of the state (particles/field.hpp).
   VectorView<Dim> node_velocity() const { return VectorView<Dim>(nodes().view(model_->fields.velocity)); }
   StressView<Dim> node_stress() const { return StressView<Dim>(nodes().view(model_->fields.stress)); }
@@ -111,6 +126,14 @@ class Simulation {
   void load_state(const io::StateArchive& archive);
 
  private:
+  static std::vector<Index> by_id(const std::vector<std::int64_t>& ids) {
+    std::vector<Index> order(ids.size());
+    for (std::size_t k = 0; k < order.size(); ++k) order[k] = static_cast<Index>(k);
+    std::sort(order.begin(), order.end(), [&ids](Index a, Index b) {
+      return ids[static_cast<std::size_t>(a)] < ids[static_cast<std::size_t>(b)];
+    });
+    return order;
+  }
   /// time.dt_rule = "current": the length of the step from t (method-notes eq. (4.3.3)).
   void choose_step(double t);
   /// A step from the current state this far below the initial one stops the run.

@@ -1,7 +1,9 @@
 // Saving and restoring the state of a Simulation for checkpoints (io/checkpoint.hpp): what
 // Simulation::step carries from one step to the next, so that a resumed run continues bit for
 // bit as if it had not stopped.
+#include <algorithm>
 #include <cstring>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -121,6 +123,29 @@ void load_set(ParticleSet<Dim>& set, std::uint64_t made, const io::StateArchive&
   }
 }
 
+// The order that takes the set as made to the checkpoint's order (V2 sorts its particles by
+// cell as they move): order[k] is the made particle whose global id the checkpoint has at k.
+// Empty when the orders agree, when the set is renewed from the checkpoint (re-seeded stress
+// points are taken as they are) or when the ids are no permutation of the made ones (then
+// load_set names the mismatch).
+template <int Dim>
+std::vector<Index> checkpoint_order(const ParticleSet<Dim>& set, const io::StateArchive& a) {
+  const std::string p = set.name() + "/";
+  if (a.has(p + "replacements") && a.integer(p + "replacements") > 0) return {};
+  const auto& ids = a.integers(p + "global_id");
+  if (ids.size() != set.global_id.size() || ids == set.global_id) return {};
+  std::vector<std::pair<std::int64_t, Index>> made(set.global_id.size());
+  for (std::size_t i = 0; i < made.size(); ++i) made[i] = {set.global_id[i], static_cast<Index>(i)};
+  std::sort(made.begin(), made.end());
+  std::vector<Index> order(ids.size());
+  for (std::size_t k = 0; k < ids.size(); ++k) {
+    const auto it = std::lower_bound(made.begin(), made.end(), std::make_pair(ids[k], Index{0}));
+    if (it == made.end() || it->first != ids[k]) return {};
+    order[k] = it->second;
+  }
+  return order;
+}
+
 std::string stage_prefix(std::size_t index, std::string_view name) {
   return fmt::format("stages/{:02d}_{}/", index, name);
 }
@@ -146,6 +171,10 @@ void Simulation<Dim>::load_state(const io::StateArchive& a) {
     throw InputError(fmt::format("the checkpoint is of the {}D scheme '{}', this case runs the {}D scheme '{}'",
                                  a.integer("scheme/dimension"), a.text("scheme/name"), Dim, scheme_->name()));
   }
+  // The particles as made, put in the checkpoint's order first (with every table that holds
+  // their indices), then given its values.
+  Reordering order{checkpoint_order(model_->nodes, a), checkpoint_order(model_->stress_points, a)};
+  if (!order.empty()) reorder(order);
   load_set(model_->nodes, nodes_made_, a);
   load_set(model_->stress_points, stress_points_made_, a);
   clock_.load(a);

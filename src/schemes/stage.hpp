@@ -8,6 +8,8 @@
 #include <utility>
 #include <vector>
 
+#include "particles/permutation.hpp"
+
 namespace rktsph {
 namespace io {
 class StateArchive;
@@ -37,6 +39,11 @@ class Stage {
   /// that the run continues bit for bit. Most stages have none.
   virtual void save(io::StateArchive& /*archive*/, const std::string& /*prefix*/) const {}
   virtual void load(const io::StateArchive& /*archive*/, const std::string& /*prefix*/) {}
+  /// Follow a reordering of the particle sets (V2 sorts them by cell at its neighbour searches;
+  /// a resume restores the checkpoint's order), after the model has moved the particles and
+  /// their fields: whatever the stage keeps per particle, or by particle index, from one step
+  /// to the next moves with it. Most stages keep nothing of the kind.
+  virtual void reordered(const Reordering& /*reordering*/) {}
   /// Figures for the log and summary.json (counts, seconds), by name; most stages have none.
   virtual std::vector<std::pair<std::string, double>> report() const { return {}; }
 };

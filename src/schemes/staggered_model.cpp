@@ -231,6 +231,26 @@ void StaggeredModel<Dim>::stress_points_changed() {
 }
 
 template <int Dim>
+void StaggeredModel<Dim>::reorder(const Reordering& r) {
+  if (r.empty()) return;
+  if (!r.nodes.empty()) {
+    if (plates) throw SolverError("the nodes of a case with rigid plates (small deformation) cannot be reordered");
+    nodes.permute(r.nodes);
+    constraints.remap(r.nodes);
+    boundary.remap(r.nodes);
+    node_sources = make_source_runs(nodes, materials);
+    // Rows by node: the rows themselves stay where they are.
+    if (!surface.row.empty()) permute_rows(surface.row, r.nodes);
+    if (!contact.row.empty()) permute_rows(contact.row, r.nodes);
+  }
+  if (!r.stress_points.empty()) {
+    stress_points.permute(r.stress_points);
+    stress_point_sources = make_source_runs(stress_points, materials);
+  }
+  ++reorders_;
+}
+
+template <int Dim>
 void StaggeredModel<Dim>::set_pore_pressure(Field<double, 1> field) {
   fields.pore_pressure = field;
   pore_pressure_ = nodes.view(field).data();

@@ -150,6 +150,14 @@ class StaggeredModel {
   /// tables made from them (the source runs); the operators are rebuilt by the V2 stage.
   void stress_points_changed();
 
+  /// Reorder the particle sets (Reordering: new particle k is old order[k]), with every table
+  /// the model keeps by particle index: the constraints, the boundary faces, the source runs,
+  /// the surface rows. The stages follow through Scheme::reordered. Operators and relations
+  /// are stale afterwards: the caller rebuilds them (V2 sorts just before its neighbour search).
+  void reorder(const Reordering& reordering);
+  /// How many reorderings changed the order so far (probes and outputs that hold indices check it).
+  long reorders() const { return reorders_; }
+
   /// Memory of the particle state and of the operators, bytes.
   std::size_t state_bytes() const { return nodes.bytes() + stress_points.bytes(); }
   std::size_t operator_bytes() const;
@@ -158,6 +166,7 @@ class StaggeredModel {
 
  private:
   const double* pore_pressure_ = nullptr;
+  long reorders_ = 0;
 };
 
 }  // namespace rktsph

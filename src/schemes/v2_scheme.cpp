@@ -1,5 +1,6 @@
 // V2: the staggered RKT-SPH step for dry soil in large deformation (method-notes §5.2):
-//   0. neighbours and operators rebuilt from the current positions (never frozen); in 2D and
+//   0. neighbours and operators rebuilt from the current positions (never frozen), the
+//      particles sorted into Morton order of their cells before each search; in 2D and
 //      3D the free surface detected and the nodal stress made traction-free on it;
 //   1. stress points: half step from the nodes, with the Jaumann rotation, the continuity
 //      equation and the new positions;
@@ -29,7 +30,15 @@ template <int Dim>
 std::unique_ptr<Scheme> make_v2_scheme(StaggeredModel<Dim>& model) {
   auto scheme = std::make_unique<Scheme>("v2");
   auto sources = std::make_shared<ViscoplasticSources<Dim>>(model);
-  auto rebuild = std::make_unique<RebuildOperators<Dim>>(model);
+  // Sorting moves the model's tables (StaggeredModel::reorder), then every stage's.
+  typename RebuildOperators<Dim>::ReorderAction reorder;
+  if (model.setup.sort_particles) {
+    reorder = [&model, s = scheme.get()](const Reordering& r) {
+      model.reorder(r);
+      s->reordered(r);
+    };
+  }
+  auto rebuild = std::make_unique<RebuildOperators<Dim>>(model, std::move(reorder));
   DetectFreeSurface<Dim>* surface = nullptr;
   std::shared_ptr<RigidContact> contact;
   if constexpr (Dim == 2) {

@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <utility>
 
 #include <fmt/format.h>
 
 #include "io/state_archive.hpp"
+#include "neighbours/morton.hpp"
 #include "operators/corrected_operator.hpp"
 #include "operators/free_surface.hpp"
 
@@ -22,11 +24,37 @@ double since(Clock::time_point t0) { return std::chrono::duration<double>(Clock:
 }  // namespace
 
 template <int Dim>
-RebuildOperators<Dim>::RebuildOperators(StaggeredModel<Dim>& model)
-    : m_(model), skin_(kSkinOverH * model.kernel.h()), constrained_positions_(model.constraints.constrained().size()) {}
+RebuildOperators<Dim>::RebuildOperators(StaggeredModel<Dim>& model, ReorderAction reorder)
+    : m_(model),
+      reorder_(std::move(reorder)),
+      skin_(kSkinOverH * model.kernel.h()),
+      constrained_positions_(model.constraints.constrained().size()) {}
 
 template <int Dim>
-void RebuildOperators<Dim>::build_relations() {
+void RebuildOperators<Dim>::sort_particles() {
+  const auto t0 = Clock::now();
+  // One grid for both sets: cells of the support's side from the lowest corner of either.
+  Vec<Dim> lo = Vec<Dim>::Constant(std::numeric_limits<double>::infinity());
+  for (const auto* set : {&m_.nodes.position, &m_.stress_points.position}) {
+    for (const Vec<Dim>& x : *set) lo = lo.cwiseMin(x);
+  }
+  const double cell = m_.kernel.support_radius();
+  if (!morton_order<Dim>(m_.nodes.position, m_.nodes.global_id, lo, cell, reordering_.nodes, sort_keys_)) {
+    reordering_.nodes.clear();
+  }
+  if (!morton_order<Dim>(m_.stress_points.position, m_.stress_points.global_id, lo, cell, reordering_.stress_points,
+                         sort_keys_)) {
+    reordering_.stress_points.clear();
+  }
+  if (!reordering_.empty()) {
+    reorder_(reordering_);
+    ++sorts_;
+  }
+  sort_seconds_ += since(t0);
+}
+
+template <int Dim>
+void RebuildOperators<Dim>::build_relations(bool new_reference) {
   const auto t0 = Clock::now();
   RelationOptions rel = operator_relation_options(m_.kernel);
   rel.radius += skin_;
@@ -40,23 +68,26 @@ void RebuildOperators<Dim>::build_relations() {
     own.radius += skin_;
     node_neighbours_.build(m_.nodes.position, m_.nodes.position, own, m_.policy);
   }
-  nodes_at_build_ = m_.nodes.position;
-  stress_points_at_build_ = m_.stress_points.position;
-  stress_point_replacements_at_build_ = m_.stress_points.replacements();
+  if (new_reference) {
+    nodes_at_build_ = m_.nodes.position;
+    stress_points_at_build_ = m_.stress_points.position;
+    stress_point_replacements_at_build_ = m_.stress_points.replacements();
+  }
   ++relation_builds_;
   relation_seconds_ += since(t0);
 }
 
 template <int Dim>
 void RebuildOperators<Dim>::run(const StepContext& c) {
-  const auto& which = m_.constraints.constrained();
-  for (std::size_t k = 0; k < which.size(); ++k) {
-    constrained_positions_[k] = m_.nodes.position[static_cast<std::size_t>(which[k])];
-  }
   // Any pair's distance changed by at most the sum of two displacements since the last search.
+  // A resumed run measures them from the checkpoint's reference positions, so that it searches
+  // (and sorts) at the steps the uninterrupted run does.
   double moved = 0.0;
   const bool renewed = m_.stress_points.replacements() != stress_point_replacements_at_build_;
-  if (relation_builds_ > 0 && !renewed) {
+  const bool resumed = resumed_;
+  resumed_ = false;
+  const bool reference = relation_builds_ > 0 || resumed;
+  if (reference && !renewed) {
     for (std::size_t i = 0; i < nodes_at_build_.size(); ++i) {
       moved = std::max(moved, (m_.nodes.position[i] - nodes_at_build_[i]).squaredNorm());
     }
@@ -64,7 +95,16 @@ void RebuildOperators<Dim>::run(const StepContext& c) {
       moved = std::max(moved, (m_.stress_points.position[i] - stress_points_at_build_[i]).squaredNorm());
     }
   }
-  if (relation_builds_ == 0 || renewed || 2.0 * std::sqrt(moved) >= skin_) build_relations();
+  const bool due = !reference || renewed || 2.0 * std::sqrt(moved) >= skin_;
+  // Sorted just before a search, so that the new lists are built on the new order.
+  if (due && reorder_) sort_particles();
+  const auto& which = m_.constraints.constrained();
+  for (std::size_t k = 0; k < which.size(); ++k) {
+    constrained_positions_[k] = m_.nodes.position[static_cast<std::size_t>(which[k])];
+  }
+  // After a resume the lists are searched afresh even when no search is due (they are not
+  // saved), keeping the checkpoint's order and reference positions.
+  if (due || relation_builds_ == 0) build_relations(due);
   const auto t0 = Clock::now();
   rebuild_corrected_operator<Dim>(to_stress_points_, m_.stress_points.position, m_.nodes, m_.kernel,
                                   m_.to_stress_points, m_.policy);
@@ -82,12 +122,38 @@ template <int Dim>
 void RebuildOperators<Dim>::save(io::StateArchive& a, const std::string& prefix) const {
   a.put_integer(prefix + "degenerate_max", degenerate_max_);
   a.put(prefix + "degenerate_first_time", degenerate_first_time_);
+  // The Verlet reference: when the next search is due, and with it the next sort.
+  auto flat = [](const std::vector<Vec<Dim>>& x) {
+    std::vector<double> out;
+    out.reserve(x.size() * Dim);
+    for (const auto& v : x) {
+      for (int d = 0; d < Dim; ++d) out.push_back(v[d]);
+    }
+    return out;
+  };
+  a.put(prefix + "verlet_nodes", flat(nodes_at_build_));
+  a.put(prefix + "verlet_stress_points", flat(stress_points_at_build_));
+  a.put_integer(prefix + "verlet_replacements", stress_point_replacements_at_build_);
 }
 
 template <int Dim>
 void RebuildOperators<Dim>::load(const io::StateArchive& a, const std::string& prefix) {
   degenerate_max_ = static_cast<Index>(a.integer(prefix + "degenerate_max"));
   degenerate_first_time_ = a.number(prefix + "degenerate_first_time");
+  if (!a.has(prefix + "verlet_nodes")) return;  // an older checkpoint: search (and sort) afresh
+  auto unflat = [](const std::vector<double>& x, std::vector<Vec<Dim>>& out) {
+    out.resize(x.size() / Dim);
+    for (std::size_t i = 0; i < out.size(); ++i) {
+      for (int d = 0; d < Dim; ++d) out[i][d] = x[i * Dim + static_cast<std::size_t>(d)];
+    }
+  };
+  unflat(a.doubles(prefix + "verlet_nodes"), nodes_at_build_);
+  unflat(a.doubles(prefix + "verlet_stress_points"), stress_points_at_build_);
+  stress_point_replacements_at_build_ = a.integer(prefix + "verlet_replacements");
+  // A reference for sets of other sizes (a re-seeding since) cannot be measured against.
+  resumed_ = nodes_at_build_.size() == m_.nodes.position.size() &&
+             (stress_points_at_build_.size() == m_.stress_points.position.size() ||
+              stress_point_replacements_at_build_ != m_.stress_points.replacements());
 }
 
 template <int Dim>
@@ -191,6 +257,20 @@ template <int Dim>
 void DetectFreeSurface<Dim>::load(const io::StateArchive& a, const std::string& prefix) {
   detections_ = a.integer(prefix + "detections");
   if (a.has(prefix + "corners")) corners_ = a.bytes(prefix + "corners");
+}
+
+template <int Dim>
+void DetectFreeSurface<Dim>::reordered(const Reordering& r) {
+  if (r.nodes.empty()) return;
+  // The constraints have been remapped: their nodes are found again.
+  std::fill(fixed_excluded_.begin(), fixed_excluded_.end(), 0);
+  for (const Index i : m_.constraints.constrained()) fixed_excluded_[static_cast<std::size_t>(i)] = 1;
+  permute_rows(excluded_, r.nodes);
+  permute_rows(flags_, r.nodes);
+  permute_rows(normals_, r.nodes);
+  permute_rows(corners_, r.nodes);  // node shifting reads them before the next detection
+  const std::vector<Index> new_index = inverse_order(r.nodes);
+  renumber(surface_, new_index);  // row k of the model's surface rows stays surface_[k]
 }
 
 template <int Dim>

@@ -2,6 +2,7 @@
 // The stages V2 adds to V1's (method-notes §5.2): the neighbour relations and corrected
 // operators rebuilt from the current positions at the start of every step.
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -20,21 +21,29 @@ namespace rktsph {
 /// positions every step (never frozen), over Verlet lists: relations built with a skin around
 /// the support, rebuilt only when some particle has moved half the skin since the last build
 /// (so that no pair within the support can be missing). Operators are plain CSR: moved
-/// particles no longer share row geometries.
+/// particles no longer share row geometries. With a `reorder` action (solver.sort = "morton"),
+/// both sets are sorted into the Morton order of their cells just before each search, and the
+/// action moves the model's and the stages' per-particle tables with them.
 template <int Dim>
 class RebuildOperators final : public Stage {
  public:
-  explicit RebuildOperators(StaggeredModel<Dim>& model);
+  using ReorderAction = std::function<void(const Reordering&)>;
+  explicit RebuildOperators(StaggeredModel<Dim>& model, ReorderAction reorder = {});
   std::string_view name() const override { return "rebuild_operators"; }
   void run(const StepContext& context) override;
   std::size_t scratch_bytes() const override {
-    return to_stress_points_.bytes() + to_nodes_.bytes() + constrained_.bytes() + node_neighbours_.bytes();
+    return to_stress_points_.bytes() + to_nodes_.bytes() + constrained_.bytes() + node_neighbours_.bytes() +
+           sort_keys_.capacity() * sizeof(std::uint64_t) +
+           (reordering_.nodes.capacity() + reordering_.stress_points.capacity()) * sizeof(Index);
   }
 
   /// Relations rebuilt (neighbour searches), operators recomputed, and the time of each, s.
   long relation_builds() const { return relation_builds_; }
   long operator_builds() const { return operator_builds_; }
   double relation_seconds() const { return relation_seconds_; }
+  /// Sorts that changed the order, and the time of all sorts (keys, sort, moving the data), s.
+  long sorts() const { return sorts_; }
+  double sort_seconds() const { return sort_seconds_; }
   double operator_seconds() const { return operator_seconds_; }
   /// The skin of the Verlet lists, m.
   double skin() const { return skin_; }
@@ -43,12 +52,15 @@ class RebuildOperators final : public Stage {
   const Relation<Dim>& node_neighbours() const { return node_neighbours_; }
   /// The stress points near each node (Verlet), for the surface nodes' difference gradient.
   const Relation<Dim>& stress_points_of_nodes() const { return to_nodes_; }
-  /// The degenerate-row record survives a resume; the lists are searched afresh after one.
+  /// The degenerate-row record and the Verlet reference survive a resume; the lists are
+  /// searched afresh after one, on the checkpoint's order.
   void save(io::StateArchive& archive, const std::string& prefix) const override;
   void load(const io::StateArchive& archive, const std::string& prefix) override;
   std::vector<std::pair<std::string, double>> report() const override {
     return {{"neighbour_searches", static_cast<double>(relation_builds_)},
             {"neighbour_search_seconds", relation_seconds_},
+            {"particle_sorts", static_cast<double>(sorts_)},
+            {"particle_sort_seconds", sort_seconds_},
             {"operator_builds", static_cast<double>(operator_builds_)},
             {"operator_build_seconds", operator_seconds_},
             {"verlet_skin", skin_},
@@ -57,9 +69,18 @@ class RebuildOperators final : public Stage {
   }
 
  private:
-  void build_relations();
+  /// Search the four relations; new_reference: measure the next trigger from the positions now.
+  void build_relations(bool new_reference);
+  /// Both sets into Morton order (neighbours/morton.hpp), through the reorder action.
+  void sort_particles();
 
   StaggeredModel<Dim>& m_;
+  ReorderAction reorder_;
+  Reordering reordering_;
+  std::vector<std::uint64_t> sort_keys_;
+  long sorts_ = 0;
+  double sort_seconds_ = 0.0;
+  bool resumed_ = false;  // the Verlet reference came from a checkpoint
   double skin_;
   Relation<Dim> to_stress_points_, to_nodes_, constrained_, node_neighbours_;
   std::vector<Vec<Dim>> constrained_positions_;
@@ -93,6 +114,7 @@ class DetectFreeSurface final : public Stage {
   }
   void save(io::StateArchive& archive, const std::string& prefix) const override;
   void load(const io::StateArchive& archive, const std::string& prefix) override;
+  void reordered(const Reordering& reordering) override;
   /// sigma.n = 0 at the flagged nodes with the normals of the last detection.
   void reapply_traction_free();
   /// Rigid bodies (2D): their contact nodes are never flagged, and a node whose flag only
@@ -144,6 +166,10 @@ class ContactSelect final : public Stage {
       : m_(model), rebuild_(rebuild), contact_(std::move(contact)) {}
   std::string_view name() const override { return "contact_select"; }
   void run(const StepContext& context) override;
+  /// The contact slots move with their nodes (the bodies' state is shared with ContactEnforce).
+  void reordered(const Reordering& reordering) override {
+    if (!reordering.nodes.empty()) contact_->reorder_nodes(reordering.nodes);
+  }
 
  private:
   StaggeredModel<2>& m_;

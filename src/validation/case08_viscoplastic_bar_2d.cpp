@@ -96,6 +96,18 @@ BarRun run_bar(const std::string& case_file, double dx) {
   const auto& sps = s.stress_points();
   const auto nn = static_cast<std::size_t>(nodes.size()), ne = static_cast<std::size_t>(sps.size());
   const std::vector<Vec<2>> X = nodes.position, XE = sps.position;
+  // V2 sorts its particles by cell as they move: particle k as made (X[k], XE[k]) is found at
+  // node_at[k] (point_at[k]) now, by its global id.
+  std::vector<Index> node_at = s.nodes_by_id(), point_at = s.stress_points_by_id();
+  long sorted_seen = s.reorders();
+  auto follow = [&] {
+    if (s.reorders() == sorted_seen) return;
+    node_at = s.nodes_by_id();
+    if (sps.replacements() == 0) point_at = s.stress_points_by_id();
+    sorted_seen = s.reorders();
+  };
+  auto at = [&](std::size_t k) { return node_at[k]; };
+  auto atu = [&](std::size_t k) { return static_cast<std::size_t>(node_at[k]); };
   auto total_mass = [&] { return s.total_mass(); };
   const double m0 = total_mass();
   // The lattice columns of nodes (by reference X) and the grips.
@@ -111,7 +123,7 @@ BarRun run_bar(const std::string& case_file, double dx) {
     double sum = 0.0;
     int n = 0;
     for (std::size_t i = 0; i < nn; ++i) {
-      if (keep(i)) sum += nodes.position[i][0], ++n;
+      if (keep(i)) sum += nodes.position[atu(i)][0], ++n;
     }
     return sum / n;
   };
@@ -120,8 +132,8 @@ BarRun run_bar(const std::string& case_file, double dx) {
     double l = 0.0, r = 0.0;
     int nl = 0, nr = 0;
     for (std::size_t i = 0; i < nn; ++i) {
-      if (left_grip[i] != 0) l += u(i, 0), ++nl;
-      if (right_grip[i] != 0) r += u(i, 0), ++nr;
+      if (left_grip[i] != 0) l += u(at(i), 0), ++nl;
+      if (right_grip[i] != 0) r += u(at(i), 0), ++nr;
     }
     return (r / nr - l / nl) / kLength;
   };
@@ -135,7 +147,9 @@ BarRun run_bar(const std::string& case_file, double dx) {
     double sum = 0.0;
     if (sps.replacements() == 0) {
       for (std::size_t e = 0; e < ne; ++e) {
-        if (XE[e][0] > a && XE[e][0] < b) sum += sps.volume[e] * sig(e, StressComponent::xx);
+        if (XE[e][0] <= a || XE[e][0] >= b) continue;
+        const Index p = point_at[e];
+        sum += sps.volume[static_cast<std::size_t>(p)] * sig(p, StressComponent::xx);
       }
     } else {
       // Re-seeded stress points (solver.reseed) have no reference position: the slab between
@@ -151,8 +165,8 @@ BarRun run_bar(const std::string& case_file, double dx) {
     std::vector<double> hi(static_cast<std::size_t>(columns), -std::numeric_limits<double>::infinity());
     for (std::size_t i = 0; i < nn; ++i) {
       const auto c = static_cast<std::size_t>(column[i]);
-      lo[c] = std::min(lo[c], nodes.position[i][1]);
-      hi[c] = std::max(hi[c], nodes.position[i][1]);
+      lo[c] = std::min(lo[c], nodes.position[atu(i)][1]);
+      hi[c] = std::max(hi[c], nodes.position[atu(i)][1]);
     }
     width = std::numeric_limits<double>::infinity();
     for (long c = 0; c < columns; ++c) {
@@ -169,10 +183,10 @@ BarRun run_bar(const std::string& case_file, double dx) {
     m.t = s.time();
     m.elongation = elongation();
     for (std::size_t i = 0; i < nn; ++i) {
-      m.x.push_back(nodes.position[i][0]);
-      m.y.push_back(nodes.position[i][1]);
-      m.eps.push_back(eps(i));
-      m.surface.push_back(nodes.view(surface)(i, 0));
+      m.x.push_back(nodes.position[atu(i)][0]);
+      m.y.push_back(nodes.position[atu(i)][1]);
+      m.eps.push_back(eps(at(i)));
+      m.surface.push_back(nodes.view(surface)(at(i), 0));
     }
     return m;
   };
@@ -183,6 +197,7 @@ BarRun run_bar(const std::string& case_file, double dx) {
   try {
     while (s.time() < kEnd - 1e-9) {
       s.step();
+      follow();
       if (s.step_count() % record_steps != 0 && s.time() < kEnd - 1e-9) continue;
       Record r;
       r.t = s.time();
@@ -202,7 +217,7 @@ BarRun run_bar(const std::string& case_file, double dx) {
       double far = 0.0, near_max = 0.0;
       int nfar = 0;
       for (std::size_t i = 0; i < nn; ++i) {
-        const double d = eps(i) - eps_before[i];
+        const double d = eps(at(i)) - eps_before[i];
         if (std::abs(X[i][0] - 1.0) < 0.2) far += d, ++nfar;
         if (std::abs(X[i][0] - r.neck_X) < 0.75 * kWidth) near_max = std::max(near_max, d);
       }
@@ -215,14 +230,14 @@ BarRun run_bar(const std::string& case_file, double dx) {
         double xn = 0.0;
         int nxn = 0;
         for (std::size_t i = 0; i < nn; ++i) {
-          if (std::abs(X[i][0] - r.neck_X) < 0.5 * dx) xn += nodes.position[i][0], ++nxn;
+          if (std::abs(X[i][0] - r.neck_X) < 0.5 * dx) xn += nodes.position[atu(i)][0], ++nxn;
         }
         xn /= nxn;
         double dmax = 0.0;
         for (std::size_t i = 0; i < nn; ++i) {
-          b.x.push_back(nodes.position[i][0]);
-          b.y.push_back(nodes.position[i][1]);
-          b.deps.push_back(eps(i) - eps_before[i]);
+          b.x.push_back(nodes.position[atu(i)][0]);
+          b.y.push_back(nodes.position[atu(i)][1]);
+          b.deps.push_back(eps(at(i)) - eps_before[i]);
           if (std::abs(b.x.back() - xn) < 0.75 * kWidth) dmax = std::max(dmax, b.deps.back());
         }
         b.in_cloud.assign(nn, 0);
@@ -237,19 +252,20 @@ BarRun run_bar(const std::string& case_file, double dx) {
         b.falling = angle_about(b.x, b.y, b.in_cloud, xc, yc, -1);
       }
       eps_before.swap(eps_last);
-      for (std::size_t i = 0; i < nn; ++i) eps_last[i] = eps(i);
+      for (std::size_t i = 0; i < nn; ++i) eps_last[i] = eps(at(i));
       if (next_map < 3 && r.elongation >= kMapElongations[next_map] - 1e-3) out.maps.push_back(snapshot()), ++next_map;
     }
   } catch (const SolverError& e) {
     out.stopped = e.what();
   }
+  follow();  // a step that failed may have sorted the particles first
   out.t_reached = s.time();
   if (out.maps.size() < 3) out.maps.push_back(snapshot());  // the last good state
   // Gaps: nodes flagged as free surface away from the bar's lateral faces (the grips are
   // never flagged): a surface opened inside the bar.
   for (std::size_t i = 0; i < nn; ++i) {
     const bool lateral = X[i][1] < 1e-9 || X[i][1] > kWidth - 1e-9;
-    if (!lateral && nodes.view(surface)(i, 0) != 0.0) ++out.interior_surface_nodes;
+    if (!lateral && nodes.view(surface)(at(i), 0) != 0.0) ++out.interior_surface_nodes;
   }
   double dmin2 = std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < nn; ++i) {

@@ -76,9 +76,14 @@ CutSnapshot snapshot(const Simulation<2>& solver, double time) {
   const auto sig = solver.node_stress();
   CutSnapshot s;
   s.time = time;
-  for (std::size_t i = 0; i < nn; ++i) {
-    s.x.push_back(nodes.position[i][0]);
-    s.y.push_back(nodes.position[i][1]);
+  // In the order the case made the nodes (V2 sorts them as they move): snapshots compare node
+  // by node.
+  const std::vector<Index> node_at = solver.nodes_by_id();
+  for (std::size_t k = 0; k < nn; ++k) {
+    const Index i = node_at[k];
+    const auto iu = static_cast<std::size_t>(i);
+    s.x.push_back(nodes.position[iu][0]);
+    s.y.push_back(nodes.position[iu][1]);
     s.ux.push_back(u(i, 0));
     s.uy.push_back(u(i, 1));
     s.vx.push_back(v(i, 0));
@@ -118,6 +123,15 @@ CutRun run_cut(const std::string& file, const std::vector<std::string>& override
     const auto& p = nodes.position[i];
     if (std::abs(p[0] - r.width) < 1e-9 && std::abs(p[1] - r.height) < 1e-9) crest = i;
   }
+  // The crest node by global id: V2 sorts its nodes as they move.
+  const std::int64_t crest_id = nodes.global_id[crest];
+  long crest_sorted = solver.reorders();
+  auto follow_crest = [&] {
+    if (crest_sorted == solver.reorders()) return;
+    const auto& ids = nodes.global_id;
+    crest = static_cast<std::size_t>(std::find(ids.begin(), ids.end(), crest_id) - ids.begin());
+    crest_sorted = solver.reorders();
+  };
   auto record = [&]() {
     double ke = 0.0;
     for (std::size_t i = 0; i < nn; ++i) {
@@ -136,6 +150,7 @@ CutRun run_cut(const std::string& file, const std::vector<std::string>& override
     for (long n = 1; n <= steps; ++n) {
       solver.step();
       if (hook) hook(solver);
+      follow_crest();
       const double uc = solver.node_displacement()(crest, 0);
       if (onset_uc > 0.0 && !r.has_onset && uc > onset_uc) {
         r.onset = snapshot(solver, solver.time());

@@ -37,7 +37,17 @@ FootingRun run_footing(const std::string& case_file, const std::vector<std::stri
   // The slab: the row of stress points (by reference height) nearest cut_y; after a re-seeding
   // (solver.reseed) the row nearest it where the new stress points are.
   std::vector<std::size_t> slab;
+  std::vector<std::int64_t> slab_ids;  // the slab by global id: V2 sorts its particles as they move
   std::int64_t slab_made = -1;
+  long slab_sorted = s.reorders();
+  auto follow_slab = [&] {
+    if (slab_sorted == s.reorders()) return;
+    slab.clear();
+    for (std::size_t e = 0; e < sps.global_id.size(); ++e) {
+      if (std::binary_search(slab_ids.begin(), slab_ids.end(), sps.global_id[e])) slab.push_back(e);
+    }
+    slab_sorted = s.reorders();
+  };
   auto select_slab = [&] {
     const std::size_t n = sps.position.size();
     double row_y = sps.position[0][1];
@@ -48,7 +58,11 @@ FootingRun run_footing(const std::string& case_file, const std::vector<std::stri
     for (std::size_t e = 0; e < n; ++e) {
       if (std::abs(sps.position[e][1] - row_y) < 0.25 * out.dx) slab.push_back(e);
     }
+    slab_ids.clear();
+    for (const std::size_t e : slab) slab_ids.push_back(sps.global_id[e]);
+    std::sort(slab_ids.begin(), slab_ids.end());
     slab_made = sps.replacements();
+    slab_sorted = s.reorders();
   };
   const HistoryView eps = node_history(s, "eps_vp_eq", "footing validation");
   auto record = [&] {
@@ -61,6 +75,7 @@ FootingRun run_footing(const std::string& case_file, const std::vector<std::stri
     r.width = b.width;
     r.pressure = b.force[1] / loaded_width;
     if (slab_made != sps.replacements()) select_slab();
+    follow_slab();
     const auto sig = s.stress_point_stress();
     double sum = 0.0;
     for (const std::size_t e : slab) sum += sig(e, StressComponent::yy) * sps.volume[e];
@@ -77,11 +92,15 @@ FootingRun run_footing(const std::string& case_file, const std::vector<std::stri
     m.settlement = -enforce->contact().state()[0].offset[1];
     const auto u = s.node_displacement();
     const auto v = s.node_velocity();
-    for (std::size_t i = 0; i < nn; ++i) {
-      m.X.push_back(X[i][0]);
-      m.Y.push_back(X[i][1]);
-      m.x.push_back(nodes.position[i][0]);
-      m.y.push_back(nodes.position[i][1]);
+    // In the order the case made the nodes (by global id), so that maps compare node by node.
+    const std::vector<Index> node_at = s.nodes_by_id();
+    for (std::size_t k = 0; k < nn; ++k) {
+      const Index i = node_at[k];
+      const auto iu = static_cast<std::size_t>(i);
+      m.X.push_back(X[k][0]);
+      m.Y.push_back(X[k][1]);
+      m.x.push_back(nodes.position[iu][0]);
+      m.y.push_back(nodes.position[iu][1]);
       m.ux.push_back(u(i, 0));
       m.uy.push_back(u(i, 1));
       m.vx.push_back(v(i, 0));

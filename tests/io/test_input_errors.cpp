@@ -204,6 +204,14 @@ TEST(InputErrors, ShiftStrengthOutOfRange) {
   expect_error_at(o, line_of(text, "shift_strength"), "solver.shift_strength", {"(0, 0.1]"});
 }
 
+TEST(InputErrors, ParticleSortUnknownOrOutsideV2) {
+  test::TempDir dir;
+  const std::string unknown = replace(kBase, "[time]", "[solver]\nversion = \"v2\"\nsort = \"hilbert\"\n[time]");
+  expect_error_at(run_case_text(dir, unknown), line_of(unknown, "sort"), "solver.sort", {"morton", "off"});
+  const std::string v1 = replace(kBase, "[time]", "[solver]\nsort = \"morton\"\n[time]");
+  expect_error_at(run_case_text(dir, v1), line_of(v1, "sort"), "solver.sort", {"v2"});
+}
+
 TEST(InputErrors, DomainBoxNeedsBothCorners) {
   test::TempDir dir;
   const std::string text = replace(kBase, "[time]", "[solver]\nversion = \"v2\"\ndomain_min = [-1.0, -1.0]\n[time]");

@@ -42,10 +42,15 @@ SpinResult spin(bool detect) {
       .initial_velocity(Vec<2>::Zero(), omega)
       .time(1.0, 0.5);
   Simulation<2> sim(b.build());
-  const std::vector<Vec<2>> start = sim.nodes().position;
+  const std::vector<Vec<2>> made = sim.nodes().position;
   SpinResult r;
   r.kinetic_start = sim.energy().kinetic;
   while (sim.time() < 1.0 - 1e-12) sim.step();
+  // Where each node now started (V2 sorts its nodes as they move; ids are the made order).
+  std::vector<Vec<2>> start(made.size());
+  for (std::size_t i = 0; i < made.size(); ++i) {
+    start[i] = made[static_cast<std::size_t>(sim.nodes().global_id[i])];
+  }
   r.external_work = sim.energy().external_work;
   r.kinetic_end = sim.energy().kinetic;
 
