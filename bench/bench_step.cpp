@@ -5,8 +5,11 @@
 #include <benchmark/benchmark.h>
 #include <omp.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <numeric>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -218,7 +221,27 @@ void BM_V2Step(benchmark::State& state) {
       .initial_velocity(Vec<2>::Zero(), 1e-3 * static_cast<double>(state.range(2)), Vec<2>(0.5 * length, 0.5 * length))
       .scheme("v2")
       .time(1.0, 0.5);
-  Simulation<2> solver(b.build());
+  CaseSetup<2> setup = b.build();
+  // Storage (the fourth argument): the order the lattice was made in (rows) or shuffled, and
+  // solver.sort off, "auto" (the default) or "always".
+  const long storage = state.range(3);
+  const bool shuffled = storage >= 2;
+  setup.sort = storage == 0 || storage == 2 ? SortSetting::off
+               : storage == 4               ? SortSetting::always
+                                            : SortSetting::automatic;
+  Simulation<2> solver(setup);
+  if (shuffled) {
+    // The storage order of a long flow: particles far apart in memory. Unsorted, the set stays
+    // so; sorted, the first search puts it back in Morton order.
+    Reordering shuffle;
+    for (auto* order : {&shuffle.nodes, &shuffle.stress_points}) {
+      const Index n = order == &shuffle.nodes ? solver.nodes().size() : solver.stress_points().size();
+      order->resize(static_cast<std::size_t>(n));
+      std::iota(order->begin(), order->end(), Index{0});
+      std::shuffle(order->begin(), order->end(), std::mt19937(12345));
+    }
+    solver.reorder(shuffle);
+  }
   for (int k = 0; k < 3; ++k) solver.step();  // the first search and the work space's growth
   const auto* rebuild = solver.scheme().find<RebuildOperators<2>>();
   if (rebuild == nullptr) {
@@ -235,6 +258,8 @@ void BM_V2Step(benchmark::State& state) {
   };
   const long searches0 = rebuild->relation_builds();
   const double search0 = rebuild->relation_seconds(), build0 = rebuild->operator_seconds();
+  const double sort0 = rebuild->sort_seconds();
+  const long sorts0 = rebuild->sorts();
   const double surface0 = surface_seconds();
   const auto t0 = std::chrono::steady_clock::now();
   for (auto _ : state) {
@@ -250,20 +275,31 @@ void BM_V2Step(benchmark::State& state) {
   state.counters["search_share"] = (rebuild->relation_seconds() - search0) / seconds;
   state.counters["operator_share"] = (rebuild->operator_seconds() - build0) / seconds;
   state.counters["surface_share"] = (surface_seconds() - surface0) / seconds;
+  state.counters["sort_share"] = (rebuild->sort_seconds() - sort0) / seconds;
+  state.counters["sorts/step"] = static_cast<double>(rebuild->sorts() - sorts0) / steps;
   state.counters["state_B/node"] = static_cast<double>(solver.state_bytes()) / nodes;
   state.counters["operator_B/node"] = static_cast<double>(solver.operator_bytes()) / nodes;
   state.counters["threads"] = static_cast<double>(state.range(1));
 }
-// Arguments: nodes, threads, the block's spin in mrad/s. At 100 mrad/s the lists are searched
-// again every ~19 steps, so most timed steps search nothing; at 1000 mrad/s (the corners at
-// 22 m/s, a fifth of the P-wave speed) every ~2 steps, a fast flow: the search's cost is then
-// in the figure (the counter searches/step says how often).
+// Arguments: nodes, threads, the block's spin in mrad/s, the storage order. At 100 mrad/s the
+// lists are searched again every ~19 steps, so most timed steps search nothing; at 1000 mrad/s
+// (the corners at 22 m/s, a fifth of the P-wave speed) every ~2 steps, a fast flow: the
+// search's cost is then in the figure (the counter searches/step says how often). Storage, in
+// the order the lattice made the particles (rows) with solver.sort 0 "off", 1 "auto" (the
+// default: kept, rows do better than Morton order); shuffled first (what a long mixing flow
+// leaves) with 2 "off", 3 "auto" (sorted at the first search), 4 "always" (every search).
 BENCHMARK(BM_V2Step)
-    ->Args({10000, 1, 100})
-    ->Args({100000, 1, 100})
-    ->Args({100000, 2, 100})
-    ->Args({100000, 1, 1000})
-    ->Args({100000, 2, 1000})
+    ->Args({10000, 1, 100, 1})
+    ->Args({100000, 1, 100, 1})
+    ->Args({100000, 1, 100, 0})
+    ->Args({100000, 1, 100, 2})
+    ->Args({100000, 1, 100, 3})
+    ->Args({100000, 1, 100, 4})
+    ->Args({100000, 2, 100, 1})
+    ->Args({100000, 1, 1000, 1})
+    ->Args({100000, 1, 1000, 3})
+    ->Args({100000, 1, 1000, 4})
+    ->Args({100000, 2, 1000, 1})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

@@ -388,13 +388,15 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     c.shift_distance = s->number("shift_distance", 0.5);
     s->require(c.shift_distance > 0.0 && c.shift_distance <= 1.0, "shift_distance",
                fmt::format("must lie in (0, 1] (a multiple of dx), got {}", c.shift_distance));
-    const std::string sort = s->string("sort", "morton");
-    if (sort == "morton") {
-      c.sort_particles = true;
+    const std::string sort = s->string("sort", "auto");
+    if (sort == "auto") {
+      c.sort = SortSetting::automatic;
+    } else if (sort == "always") {
+      c.sort = SortSetting::always;
     } else if (sort == "off") {
-      c.sort_particles = false;
+      c.sort = SortSetting::off;
     } else {
-      s->fail("sort", fmt::format("unknown value '{}' (known: morton, off)", sort));
+      s->fail("sort", fmt::format("unknown value '{}' (known: auto, always, off)", sort));
     }
     if (s->has("sort")) {
       s->require(c.version == "v2", "sort",

@@ -153,6 +153,9 @@ struct ProbeSpec {
 
 /// When V2 re-seeds its stress points (solver.reseed).
 enum class ReseedSetting { off, automatic, periodic };
+/// When V2 sorts its particles into Morton order (solver.sort).
+enum class SortSetting { off, automatic, always };
+
 /// When V2 shifts its nodes (solver.shift).
 enum class ShiftSetting { off, automatic, periodic };
 
@@ -269,9 +272,10 @@ struct CaseSetup {
   long shift_interval = 20;
   double shift_strength = 0.01;
   double shift_distance = 0.5;
-  /// V2: the particle sets stored in Morton order of their cells, sorted again at every
-  /// neighbour search (method-notes §3.8, "Storage order"; solver.sort = "morton" | "off").
-  bool sort_particles = true;
+  /// V2: when the particle sets are sorted into Morton order of their cells (method-notes
+  /// §3.8, "Storage order"; solver.sort): never, at a neighbour search once the storage order
+  /// has become disordered (the mean index gap of neighbour pairs doubled), or at every search.
+  SortSetting sort = SortSetting::automatic;
   /// V2: the domain box [min, max] (solver.domain_min / domain_max): particles that leave it
   /// are deactivated (schemes/deactivate_stage.hpp); empty: no box. `domain_where` names the
   /// keys' file and line for the errors found once the particles exist.

@@ -167,29 +167,25 @@ class ParticleSet {
     for (const Column& c : columns_) {
       if ((c.info.flags & flags) != 0 || (c.info.flags == 0 && flags == ~0u)) b += c.bytes();
     }
-    if (flags == ~0u) {  // the work space of permute()
-      b += scratch_.vec.capacity() * sizeof(Vec<Dim>) + scratch_.f64.capacity() * sizeof(double) +
-           scratch_.u8.capacity() + scratch_.i64.capacity() * sizeof(std::int64_t) + scratch_.i32.capacity() * sizeof(int);
-    }
     return b;
   }
 
   /// Reorder: particle k of the result is particle order[k] of this set (a permutation of
   /// [0, size())). Every property and field moves with its particle, in place: views and
-  /// pointers into the arrays stay valid. The work space is kept, so a set sorted again and
-  /// again (V2, at every neighbour search) allocates nothing after the first time.
+  /// pointers into the arrays stay valid. Each array is copied once into a temporary (V2 sorts
+  /// rarely, method-notes §3.8; no memory is held for it between sorts).
   void permute(const std::vector<Index>& order) {
     if (order.size() != position.size()) throw SolverError(fmt::format("{}: permutation of the wrong size", name_));
-    permute_rows(position, order, 1, scratch_.vec);
-    permute_rows(volume, order, 1, scratch_.f64);
-    permute_rows(density, order, 1, scratch_.f64);
-    permute_rows(material, order, 1, scratch_.i32);
-    permute_rows(global_id, order, 1, scratch_.i64);
+    permute_rows(position, order);
+    permute_rows(volume, order);
+    permute_rows(density, order);
+    permute_rows(material, order);
+    permute_rows(global_id, order);
     for (Column& c : columns_) {
       const auto n = static_cast<std::size_t>(c.info.components);
-      permute_rows(c.f64, order, n, scratch_.f64);
-      permute_rows(c.u8, order, n, scratch_.u8);
-      permute_rows(c.i64, order, n, scratch_.i64);
+      permute_rows(c.f64, order, n);
+      permute_rows(c.u8, order, n);
+      permute_rows(c.i64, order, n);
     }
   }
 
@@ -243,13 +239,6 @@ class ParticleSet {
   Index owned_ = 0;
   std::int64_t replacements_ = 0;
   std::vector<Column> columns_;
-  struct Scratch {
-    std::vector<Vec<Dim>> vec;
-    std::vector<double> f64;
-    std::vector<std::uint8_t> u8;
-    std::vector<std::int64_t> i64;
-    std::vector<int> i32;
-  } scratch_;
 };
 
 }  // namespace rktsph

@@ -25,21 +25,8 @@ inline std::vector<Index> inverse_order(const std::vector<Index>& order) {
   return new_index;
 }
 
-/// Rows of `stride` values: row k becomes row order[k]. `scratch` only grows, so a kept one
-/// allocates nothing after the first call. An empty array (an unused field) stays empty.
-template <class T>
-void permute_rows(std::vector<T>& values, const std::vector<Index>& order, std::size_t stride,
-                  std::vector<T>& scratch) {
-  if (values.empty()) return;
-  scratch.resize(values.size());
-  std::copy(values.begin(), values.end(), scratch.begin());
-  for (std::size_t k = 0; k < order.size(); ++k) {
-    const auto from = static_cast<std::ptrdiff_t>(static_cast<std::size_t>(order[k]) * stride);
-    std::copy_n(scratch.begin() + from, stride, values.begin() + static_cast<std::ptrdiff_t>(k * stride));
-  }
-}
-
-/// The same with a scratch array of its own (small arrays, or a one-off reordering).
+/// Rows of `stride` values: row k becomes row order[k], in place (through one copy). An empty
+/// array (an unused field) stays empty.
 template <class T>
 void permute_rows(std::vector<T>& values, const std::vector<Index>& order, std::size_t stride = 1) {
   if (values.empty()) return;

@@ -32,7 +32,7 @@ std::unique_ptr<Scheme> make_v2_scheme(StaggeredModel<Dim>& model) {
   auto sources = std::make_shared<ViscoplasticSources<Dim>>(model);
   // Sorting moves the model's tables (StaggeredModel::reorder), then every stage's.
   typename RebuildOperators<Dim>::ReorderAction reorder;
-  if (model.setup.sort_particles) {
+  if (model.setup.sort != SortSetting::off) {
     reorder = [&model, s = scheme.get()](const Reordering& r) {
       model.reorder(r);
       s->reordered(r);

@@ -31,8 +31,7 @@ RebuildOperators<Dim>::RebuildOperators(StaggeredModel<Dim>& model, ReorderActio
       constrained_positions_(model.constraints.constrained().size()) {}
 
 template <int Dim>
-void RebuildOperators<Dim>::sort_particles() {
-  const auto t0 = Clock::now();
+bool RebuildOperators<Dim>::morton_orders() {
   // One grid for both sets: cells of the support's side from the lowest corner of either.
   Vec<Dim> lo = Vec<Dim>::Constant(std::numeric_limits<double>::infinity());
   for (const auto* set : {&m_.nodes.position, &m_.stress_points.position}) {
@@ -46,11 +45,36 @@ void RebuildOperators<Dim>::sort_particles() {
                          sort_keys_)) {
     reordering_.stress_points.clear();
   }
-  if (!reordering_.empty()) {
-    reorder_(reordering_);
-    ++sorts_;
+  return !reordering_.empty();
+}
+
+template <int Dim>
+void RebuildOperators<Dim>::apply_sort() {
+  reorder_(reordering_);
+  ++sorts_;
+}
+
+template <int Dim>
+double RebuildOperators<Dim>::storage_gap(const Reordering* r) const {
+  // Over the pairs of the nodes' relation (node a, stress point j): |a n_s / n_n - j|, both
+  // indices as they are, or as they would be after the reordering r.
+  const auto& off = to_nodes_.offsets();
+  const auto& src = to_nodes_.indices();
+  const auto nn = static_cast<std::size_t>(m_.nodes.size()), ns = static_cast<std::size_t>(m_.stress_points.size());
+  if (nn == 0 || src.empty()) return 0.0;
+  std::vector<Index> node_at, point_at;
+  if (r != nullptr && !r->nodes.empty()) node_at = inverse_order(r->nodes);
+  if (r != nullptr && !r->stress_points.empty()) point_at = inverse_order(r->stress_points);
+  const double ratio = static_cast<double>(ns) / static_cast<double>(nn);
+  double sum = 0.0;
+  for (std::size_t a = 0; a < nn; ++a) {
+    const double at = ratio * static_cast<double>(node_at.empty() ? static_cast<Index>(a) : node_at[a]);
+    for (auto k = static_cast<std::size_t>(off[a]); k < static_cast<std::size_t>(off[a + 1]); ++k) {
+      const auto j = static_cast<std::size_t>(src[k]);
+      sum += std::abs(at - static_cast<double>(point_at.empty() ? static_cast<Index>(j) : point_at[j]));
+    }
   }
-  sort_seconds_ += since(t0);
+  return sum / static_cast<double>(src.size());
 }
 
 template <int Dim>
@@ -96,8 +120,15 @@ void RebuildOperators<Dim>::run(const StepContext& c) {
     }
   }
   const bool due = !reference || renewed || 2.0 * std::sqrt(moved) >= skin_;
-  // Sorted just before a search, so that the new lists are built on the new order.
-  if (due && reorder_) sort_particles();
+  // Sorted just before a search, so that the new lists are built on the new order: at every
+  // search ("always"), or once the gap measured at the last search has doubled since the last
+  // sort ("auto"; the gap of the next lists is not known before the search).
+  const auto ts = Clock::now();
+  bool sorted = false;
+  if (due && reorder_ && (m_.setup.sort == SortSetting::always || (gap_ref_ > 0.0 && gap_ > kResortGap * gap_ref_))) {
+    if (morton_orders()) apply_sort(), sorted = true;
+  }
+  sort_seconds_ += since(ts);
   const auto& which = m_.constraints.constrained();
   for (std::size_t k = 0; k < which.size(); ++k) {
     constrained_positions_[k] = m_.nodes.position[static_cast<std::size_t>(which[k])];
@@ -105,6 +136,26 @@ void RebuildOperators<Dim>::run(const StepContext& c) {
   // After a resume the lists are searched afresh even when no search is due (they are not
   // saved), keeping the checkpoint's order and reference positions.
   if (due || relation_builds_ == 0) build_relations(due);
+  if (due && reorder_) {
+    const auto tg = Clock::now();
+    gap_ = storage_gap();
+    if (gap_ref_ < 0.0 && !sorted) {
+      // The first search: the order the case made the particles in is kept unless Morton's
+      // would do better by the same factor (a lattice's rows do better still; a particle
+      // file in no order does not).
+      if (morton_orders() && gap_ > kResortGap * storage_gap(&reordering_)) {
+        apply_sort();
+        sorted = true;
+        for (std::size_t k = 0; k < which.size(); ++k) {
+          constrained_positions_[k] = m_.nodes.position[static_cast<std::size_t>(which[k])];
+        }
+        build_relations(true);
+        gap_ = storage_gap();
+      }
+    }
+    if (sorted || gap_ref_ < 0.0) gap_ref_ = gap_;
+    sort_seconds_ += since(tg);
+  }
   const auto t0 = Clock::now();
   rebuild_corrected_operator<Dim>(to_stress_points_, m_.stress_points.position, m_.nodes, m_.kernel,
                                   m_.to_stress_points, m_.policy);

@@ -21,9 +21,10 @@ namespace rktsph {
 /// positions every step (never frozen), over Verlet lists: relations built with a skin around
 /// the support, rebuilt only when some particle has moved half the skin since the last build
 /// (so that no pair within the support can be missing). Operators are plain CSR: moved
-/// particles no longer share row geometries. With a `reorder` action (solver.sort = "morton"),
-/// both sets are sorted into the Morton order of their cells just before each search, and the
-/// action moves the model's and the stages' per-particle tables with them.
+/// particles no longer share row geometries. With a `reorder` action (solver.sort = "auto" or
+/// "always"), both sets are sorted into the Morton order of their cells just before a search
+/// (every one, or once the storage has become disordered), and the action moves the model's
+/// and the stages' per-particle tables with them.
 template <int Dim>
 class RebuildOperators final : public Stage {
  public:
@@ -41,7 +42,8 @@ class RebuildOperators final : public Stage {
   long relation_builds() const { return relation_builds_; }
   long operator_builds() const { return operator_builds_; }
   double relation_seconds() const { return relation_seconds_; }
-  /// Sorts that changed the order, and the time of all sorts (keys, sort, moving the data), s.
+  /// Sorts that changed the order, and the time of the sorting (keys, sort, moving the data,
+  /// and the gap measures that decide it), s.
   long sorts() const { return sorts_; }
   double sort_seconds() const { return sort_seconds_; }
   double operator_seconds() const { return operator_seconds_; }
@@ -61,6 +63,7 @@ class RebuildOperators final : public Stage {
             {"neighbour_search_seconds", relation_seconds_},
             {"particle_sorts", static_cast<double>(sorts_)},
             {"particle_sort_seconds", sort_seconds_},
+            {"storage_gap_last_search", gap_},
             {"operator_builds", static_cast<double>(operator_builds_)},
             {"operator_build_seconds", operator_seconds_},
             {"verlet_skin", skin_},
@@ -71,8 +74,16 @@ class RebuildOperators final : public Stage {
  private:
   /// Search the four relations; new_reference: measure the next trigger from the positions now.
   void build_relations(bool new_reference);
-  /// Both sets into Morton order (neighbours/morton.hpp), through the reorder action.
-  void sort_particles();
+  /// The Morton orders of both sets (neighbours/morton.hpp) into reordering_; false when both
+  /// are sorted already.
+  bool morton_orders();
+  /// Apply reordering_ through the reorder action.
+  void apply_sort();
+  /// The storage's disorder: the mean index gap over the nodes' relation pairs (a node's index
+  /// scaled to the stress points' count against its stress point's), as stored or after r.
+  double storage_gap(const Reordering* r = nullptr) const;
+  /// "auto" sorts once the gap exceeds this multiple of its value after the last sort.
+  static constexpr double kResortGap = 2.0;
 
   StaggeredModel<Dim>& m_;
   ReorderAction reorder_;
@@ -80,6 +91,7 @@ class RebuildOperators final : public Stage {
   std::vector<std::uint64_t> sort_keys_;
   long sorts_ = 0;
   double sort_seconds_ = 0.0;
+  double gap_ = -1.0, gap_ref_ = -1.0;  // storage gap at the last search and after the last sort
   bool resumed_ = false;  // the Verlet reference came from a checkpoint
   double skin_;
   Relation<Dim> to_stress_points_, to_nodes_, constrained_, node_neighbours_;

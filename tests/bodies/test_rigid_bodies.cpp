@@ -275,7 +275,7 @@ TEST(RigidBodies, SortingTheParticlesLeavesTheFootingRunUnchanged) {
   auto run = [](bool sort) {
     CaseSetup<2> c = footing_case();
     c.bodies[2].velocity = {0.0, -2.0};  // m/s: 8 cm in the 0.04 s, across a row of sort cells
-    c.sort_particles = sort;
+    c.sort = sort ? SortSetting::always : SortSetting::off;
     auto sim = std::make_unique<Simulation<2>>(c);
     while (sim->time() < 0.04 - 1e-12) sim->step();
     return sim;

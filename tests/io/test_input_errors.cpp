@@ -207,8 +207,8 @@ TEST(InputErrors, ShiftStrengthOutOfRange) {
 TEST(InputErrors, ParticleSortUnknownOrOutsideV2) {
   test::TempDir dir;
   const std::string unknown = replace(kBase, "[time]", "[solver]\nversion = \"v2\"\nsort = \"hilbert\"\n[time]");
-  expect_error_at(run_case_text(dir, unknown), line_of(unknown, "sort"), "solver.sort", {"morton", "off"});
-  const std::string v1 = replace(kBase, "[time]", "[solver]\nsort = \"morton\"\n[time]");
+  expect_error_at(run_case_text(dir, unknown), line_of(unknown, "sort"), "solver.sort", {"auto", "always", "off"});
+  const std::string v1 = replace(kBase, "[time]", "[solver]\nsort = \"always\"\n[time]");
   expect_error_at(run_case_text(dir, v1), line_of(v1, "sort"), "solver.sort", {"v2"});
 }
 

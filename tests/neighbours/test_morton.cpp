@@ -91,7 +91,9 @@ TEST(Morton, OrderSortsByKeyThenIdWhateverTheStartingOrder) {
     }
     for (std::size_t k = 1; k < ids.size(); ++k) {
       ASSERT_LE(sorted_keys[k - 1], sorted_keys[k]);
-      if (sorted_keys[k - 1] == sorted_keys[k]) ASSERT_LT(ids[k - 1], ids[k]);
+      if (sorted_keys[k - 1] == sorted_keys[k]) {
+        ASSERT_LT(ids[k - 1], ids[k]);
+      }
     }
     if (first.empty()) first = ids;
     EXPECT_EQ(ids, first) << "the order depends on the positions and ids only";

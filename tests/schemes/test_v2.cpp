@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstring>
 #include <numbers>
+#include <numeric>
 #include <random>
 
 #include "../support/test_util.hpp"
@@ -73,7 +74,8 @@ TEST(V2, AUniformStressRotatesObjectivelyOverAQuarterTurn) {
   EXPECT_LT(worst / 3.0e4, 1e-11) << "max stress error " << worst << " Pa";
   // The body turned: a corner node is where the rotation took it (to the first order of dt).
   EXPECT_NEAR(sim.nodes().position[static_cast<std::size_t>(at[0])][0], 1.0, 0.02);
-  EXPECT_GT(sim.reorders(), 0);  // the turning block was sorted again as it moved
+  // solver.sort = "auto": a turning block keeps its neighbours near in memory, no sort.
+  EXPECT_EQ(sim.reorders(), 0);
 }
 
 // A V2 flow disorders the particles; the operators rebuilt at their positions reproduce a linear
@@ -186,7 +188,7 @@ TEST(V2Sort, SortedAndUnsortedRunsAgreeParticleByParticle) {
     CaseBuilder<2> b = block(2000.0);
     b.free_surface(true).initial_velocity(Vec<2>::Zero(), 2.0).time(0.5, 0.5);
     CaseSetup<2> c = b.build();
-    c.sort_particles = sort;
+    c.sort = sort ? SortSetting::always : SortSetting::off;
     auto sim = std::make_unique<Simulation<2>>(c);
     while (sim->time() < 0.5 - 1e-12) sim->step();
     return sim;
@@ -276,6 +278,51 @@ TEST(V2Sort, ReorderingMovesTheConstraintsAndFacesWithTheirNodes) {
       EXPECT_DOUBLE_EQ(v(k, 0), 0.25) << k;
     }
   }
+}
+
+}  // namespace
+}  // namespace rktsph
+
+namespace rktsph {
+namespace {
+
+// solver.sort = "auto" (method-notes §3.8, "Storage order"): a lattice keeps the order it was
+// made in (its rows beat Morton order), a set stored in no order (shuffled) is sorted at the
+// first search, and the storage gap falls from about a third of the set to a few rows.
+TEST(V2Sort, AutoSortsAShuffledSetAndKeepsALattice) {
+  const test::ThreadCount threads(1);
+  auto gap_after_first_step = [](bool shuffle, long& sorts) {
+    CaseBuilder<2> b = block(2000.0);
+    b.time(0.01, 0.5);
+    Simulation<2> sim(b.build());
+    if (shuffle) {
+      Reordering r;
+      for (auto* order : {&r.nodes, &r.stress_points}) {
+        const Index n = order == &r.nodes ? sim.nodes().size() : sim.stress_points().size();
+        order->resize(static_cast<std::size_t>(n));
+        std::iota(order->begin(), order->end(), Index{0});
+        std::shuffle(order->begin(), order->end(), std::mt19937(3));
+      }
+      sim.reorder(r);
+    }
+    sim.step();
+    const auto* rebuild = sim.scheme().find<RebuildOperators<2>>();
+    sorts = rebuild->sorts();
+    for (const auto& [key, value] : rebuild->report()) {
+      if (key == "storage_gap_last_search") return value;
+    }
+    return -1.0;
+  };
+  long sorts_lattice = -1, sorts_shuffled = -1;
+  const double lattice = gap_after_first_step(false, sorts_lattice);
+  const double shuffled = gap_after_first_step(true, sorts_shuffled);
+  std::printf("storage gap after the first search: lattice %.1f (%ld sorts), shuffled %.1f (%ld sorts)\n", lattice,
+              sorts_lattice, shuffled, sorts_shuffled);
+  EXPECT_EQ(sorts_lattice, 0);
+  EXPECT_EQ(sorts_shuffled, 1);
+  EXPECT_GT(lattice, 0.0);
+  EXPECT_LT(lattice, 30.0);   // a row of the 21 x 21 lattice and a bit
+  EXPECT_LT(shuffled, 45.0);  // sorted: Morton's gap, against ~147 (a third of 441) shuffled
 }
 
 }  // namespace
