@@ -8,8 +8,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
-#include <numeric>
-#include <random>
 #include <string>
 #include <vector>
 
@@ -233,14 +231,7 @@ void BM_V2Step(benchmark::State& state) {
   if (shuffled) {
     // The storage order of a long flow: particles far apart in memory. Unsorted, the set stays
     // so; sorted, the first search puts it back in Morton order.
-    Reordering shuffle;
-    for (auto* order : {&shuffle.nodes, &shuffle.stress_points}) {
-      const Index n = order == &shuffle.nodes ? solver.nodes().size() : solver.stress_points().size();
-      order->resize(static_cast<std::size_t>(n));
-      std::iota(order->begin(), order->end(), Index{0});
-      std::shuffle(order->begin(), order->end(), std::mt19937(12345));
-    }
-    solver.reorder(shuffle);
+    solver.reorder(shuffled_orders(solver.nodes().size(), solver.stress_points().size(), 12345));
   }
   for (int k = 0; k < 3; ++k) solver.step();  // the first search and the work space's growth
   const auto* rebuild = solver.scheme().find<RebuildOperators<2>>();

@@ -5,6 +5,9 @@
 // pointer into it, stays valid).
 #include <algorithm>
 #include <cstddef>
+#include <cstdint>
+#include <numeric>
+#include <random>
 #include <vector>
 
 #include "core/types.hpp"
@@ -17,6 +20,18 @@ struct Reordering {
   std::vector<Index> stress_points;
   bool empty() const { return nodes.empty() && stress_points.empty(); }
 };
+
+/// A random reordering of both sets (what a long mixing flow leaves in memory), the same for a
+/// given seed: for tests and benchmarks of the storage order.
+inline Reordering shuffled_orders(Index nodes, Index stress_points, std::uint32_t seed) {
+  Reordering r;
+  for (auto* order : {&r.nodes, &r.stress_points}) {
+    order->resize(static_cast<std::size_t>(order == &r.nodes ? nodes : stress_points));
+    std::iota(order->begin(), order->end(), Index{0});
+    std::shuffle(order->begin(), order->end(), std::mt19937(seed));
+  }
+  return r;
+}
 
 /// new_index[old] = new: where each particle went.
 inline std::vector<Index> inverse_order(const std::vector<Index>& order) {

@@ -7,7 +7,6 @@
 #include <cmath>
 #include <cstring>
 #include <numbers>
-#include <numeric>
 #include <random>
 
 #include "../support/test_util.hpp"
@@ -295,16 +294,7 @@ TEST(V2Sort, AutoSortsAShuffledSetAndKeepsALattice) {
     CaseBuilder<2> b = block(2000.0);
     b.time(0.01, 0.5);
     Simulation<2> sim(b.build());
-    if (shuffle) {
-      Reordering r;
-      for (auto* order : {&r.nodes, &r.stress_points}) {
-        const Index n = order == &r.nodes ? sim.nodes().size() : sim.stress_points().size();
-        order->resize(static_cast<std::size_t>(n));
-        std::iota(order->begin(), order->end(), Index{0});
-        std::shuffle(order->begin(), order->end(), std::mt19937(3));
-      }
-      sim.reorder(r);
-    }
+    if (shuffle) sim.reorder(shuffled_orders(sim.nodes().size(), sim.stress_points().size(), 3));
     sim.step();
     const auto* rebuild = sim.scheme().find<RebuildOperators<2>>();
     sorts = rebuild->sorts();
