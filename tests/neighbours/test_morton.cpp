@@ -99,7 +99,8 @@ TEST(Morton, OrderSortsByKeyThenIdWhateverTheStartingOrder) {
     EXPECT_EQ(ids, first) << "the order depends on the positions and ids only";
     // Once sorted, the set is recognised as sorted: no reordering, the identity returned.
     Cloud sorted;
-    for (const Index i : order) sorted.x.push_back(c.x[static_cast<std::size_t>(i)]), sorted.id.push_back(c.id[static_cast<std::size_t>(i)]);
+    for (const Index i : order)
+      sorted.x.push_back(c.x[static_cast<std::size_t>(i)]), sorted.id.push_back(c.id[static_cast<std::size_t>(i)]);
     std::vector<Index> again;
     EXPECT_FALSE(morton_order<2>(sorted.x, sorted.id, lo, cell, again, keys));
     for (std::size_t k = 0; k < again.size(); ++k) ASSERT_EQ(again[k], static_cast<Index>(k));
