@@ -208,7 +208,8 @@ TEST(V2Sort, SortedAndUnsortedRunsAgreeParticleByParticle) {
   for (std::size_t k = 0; k < a.size(); ++k) {
     const Index i = a[k], j = b[k];
     dx = std::max(dx, (sorted->nodes().position[static_cast<std::size_t>(i)] -
-                       plain->nodes().position[static_cast<std::size_t>(j)]).norm());
+                       plain->nodes().position[static_cast<std::size_t>(j)])
+                          .norm());
     dv = std::max(dv, (va.vec(i) - vb.vec(j)).norm());
     vmax = std::max(vmax, vb.vec(j).norm());
     for (const auto c : {StressComponent::xx, StressComponent::yy, StressComponent::xy}) {
@@ -237,7 +238,8 @@ namespace {
 // before it, and the constrained list stays ascending.
 TEST(V2Sort, ReorderingMovesTheConstraintsAndFacesWithTheirNodes) {
   CaseBuilder<2> b = block(2000.0);
-  b.time(0.01, 0.5).fix_velocity(Region<2>::box(Vec<2>(-1.0, -1.0), Vec<2>(1.0, -0.95)), {1})
+  b.time(0.01, 0.5)
+      .fix_velocity(Region<2>::box(Vec<2>(-1.0, -1.0), Vec<2>(1.0, -0.95)), {1})
       .prescribe_velocity(Region<2>::box(Vec<2>(-1.0, -1.0), Vec<2>(-0.95, 1.0)), {{0, 0.25}});
   Simulation<2> sim(b.build());
   StaggeredModel<2>& m = sim.model();
