@@ -185,6 +185,10 @@ void RebuildOperators<Dim>::save(io::StateArchive& a, const std::string& prefix)
   a.put(prefix + "verlet_nodes", flat(nodes_at_build_));
   a.put(prefix + "verlet_stress_points", flat(stress_points_at_build_));
   a.put_integer(prefix + "verlet_replacements", stress_point_replacements_at_build_);
+  // What decides the next sort under "auto".
+  a.put(prefix + "storage_gap", gap_);
+  a.put(prefix + "storage_gap_reference", gap_ref_);
+  a.put_integer(prefix + "sorts", sorts_);
 }
 
 template <int Dim>
@@ -192,6 +196,11 @@ void RebuildOperators<Dim>::load(const io::StateArchive& a, const std::string& p
   degenerate_max_ = static_cast<Index>(a.integer(prefix + "degenerate_max"));
   degenerate_first_time_ = a.number(prefix + "degenerate_first_time");
   if (!a.has(prefix + "verlet_nodes")) return;  // an older checkpoint: search (and sort) afresh
+  if (a.has(prefix + "storage_gap")) {
+    gap_ = a.number(prefix + "storage_gap");
+    gap_ref_ = a.number(prefix + "storage_gap_reference");
+    sorts_ = static_cast<long>(a.integer(prefix + "sorts"));
+  }
   auto unflat = [](const std::vector<double>& x, std::vector<Vec<Dim>>& out) {
     out.resize(x.size() / Dim);
     for (std::size_t i = 0; i < out.size(); ++i) {
