@@ -344,8 +344,7 @@ int run_loop(const LoopInput& in) {
   auto record_probes = [&] {
     if (solver.reorders() != probes_reorders) {
       // The nodes were reordered (sorted by cell): find each probe's node again by its id.
-      const auto& ids = solver.nodes().global_id;
-      for (auto& p : probes) p.node = static_cast<Index>(std::find(ids.begin(), ids.end(), p.id) - ids.begin());
+      for (auto& p : probes) p.node = solver.node_with_id(p.id);
       probes_reorders = solver.reorders();
     }
     std::string row = fmt::format("{:.10g}", solver.time());

@@ -1,9 +1,9 @@
 #pragma once
-#include <algorithm>
 // A run of a case: the model (particles, operators, constraints), the scheme made for it by
 // name (schemes/registry.hpp) and the time control. step() is the algorithm of one time step
 // as written in method-notes §5: the scheme's stages in order, then the step's balance
 // (momentum, kinetic energy, a non-finite check), the energy account and the growth guard.
+#include <algorithm>
 #include <memory>
 #include <span>
 #include <string>
@@ -83,6 +83,13 @@ class Simulation {
   /// any reordering), for comparisons across time by particle.
   std::vector<Index> nodes_by_id() const { return by_id(nodes().global_id); }
   std::vector<Index> stress_points_by_id() const { return by_id(stress_points().global_id); }
+  /// The node with global id `id` now (a linear search: for the few nodes followed across a
+  /// reordering, e.g. probes); -1 if none.
+  Index node_with_id(std::int64_t id) const {
+    const auto& ids = nodes().global_id;
+    const auto it = std::find(ids.begin(), ids.end(), id);
+    return it == ids.end() ? Index{-1} : static_cast<Index>(it - ids.begin());
+  }
 
   // Typed views of the state (particles/field.hpp).
   VectorView<Dim> node_velocity() const { return VectorView<Dim>(nodes().view(model_->fields.velocity)); }

@@ -49,6 +49,14 @@ bool RebuildOperators<Dim>::morton_orders() {
 }
 
 template <int Dim>
+void RebuildOperators<Dim>::gather_constrained_positions() {
+  const auto& which = m_.constraints.constrained();
+  for (std::size_t k = 0; k < which.size(); ++k) {
+    constrained_positions_[k] = m_.nodes.position[static_cast<std::size_t>(which[k])];
+  }
+}
+
+template <int Dim>
 void RebuildOperators<Dim>::apply_sort() {
   reorder_(reordering_);
   ++sorts_;
@@ -129,10 +137,7 @@ void RebuildOperators<Dim>::run(const StepContext& c) {
     if (morton_orders()) apply_sort(), sorted = true;
   }
   sort_seconds_ += since(ts);
-  const auto& which = m_.constraints.constrained();
-  for (std::size_t k = 0; k < which.size(); ++k) {
-    constrained_positions_[k] = m_.nodes.position[static_cast<std::size_t>(which[k])];
-  }
+  gather_constrained_positions();
   // After a resume the lists are searched afresh even when no search is due (they are not
   // saved), keeping the checkpoint's order and reference positions.
   if (due || relation_builds_ == 0) build_relations(due);
@@ -146,9 +151,7 @@ void RebuildOperators<Dim>::run(const StepContext& c) {
       if (morton_orders() && gap_ > kResortGap * storage_gap(&reordering_)) {
         apply_sort();
         sorted = true;
-        for (std::size_t k = 0; k < which.size(); ++k) {
-          constrained_positions_[k] = m_.nodes.position[static_cast<std::size_t>(which[k])];
-        }
+        gather_constrained_positions();
         build_relations(true);
         gap_ = storage_gap();
       }
@@ -325,12 +328,10 @@ void DetectFreeSurface<Dim>::reordered(const Reordering& r) {
   // The constraints have been remapped: their nodes are found again.
   std::fill(fixed_excluded_.begin(), fixed_excluded_.end(), 0);
   for (const Index i : m_.constraints.constrained()) fixed_excluded_[static_cast<std::size_t>(i)] = 1;
-  permute_rows(excluded_, r.nodes);
-  permute_rows(flags_, r.nodes);
-  permute_rows(normals_, r.nodes);
-  permute_rows(corners_, r.nodes);  // node shifting reads them before the next detection
-  const std::vector<Index> new_index = inverse_order(r.nodes);
-  renumber(surface_, new_index);  // row k of the model's surface rows stays surface_[k]
+  permute_rows(excluded_, r.nodes);  // it keeps the deactivated nodes
+  permute_rows(corners_, r.nodes);   // node shifting reads them before the next detection
+  // flags_, normals_ and surface_ are not read before the next detection rewrites them (the
+  // sort runs before it in the step; a resume detects before the step's end needs them).
 }
 
 template <int Dim>

@@ -79,6 +79,8 @@ class RebuildOperators final : public Stage {
   bool morton_orders();
   /// Apply reordering_ through the reorder action.
   void apply_sort();
+  /// The constrained nodes' positions, in constrained() order (after any reordering).
+  void gather_constrained_positions();
   /// The storage's disorder: the mean index gap over the nodes' relation pairs (a node's index
   /// scaled to the stress points' count against its stress point's), as stored or after r.
   double storage_gap(const Reordering* r = nullptr) const;

@@ -128,8 +128,7 @@ CutRun run_cut(const std::string& file, const std::vector<std::string>& override
   long crest_sorted = solver.reorders();
   auto follow_crest = [&] {
     if (crest_sorted == solver.reorders()) return;
-    const auto& ids = nodes.global_id;
-    crest = static_cast<std::size_t>(std::find(ids.begin(), ids.end(), crest_id) - ids.begin());
+    crest = static_cast<std::size_t>(solver.node_with_id(crest_id));
     crest_sorted = solver.reorders();
   };
   auto record = [&]() {
