@@ -27,19 +27,86 @@ struct SaturatedColumn {
   double time_factor(double t) const { return cv() * t / (height * height); }
 };
 
-/// Terzaghi consolidation (docs/cases.md Case 13) under a load ramped linearly from 0 to q over
-/// `ramp` seconds (exact convolution of the step solution with the ramp; ramp = 0: a step).
+/// Terzaghi consolidation (docs/cases.md Case 13) under a load raised from 0 to q over `ramp`
+/// seconds, linearly or by the quintic smoothstep S(s) = 10 s^3 - 15 s^4 + 6 s^5 (the case
+/// file's "ramp" and "smoothstep" functions): the step solution convolved exactly with the load
+/// history (ramp = 0: a step).
 struct Terzaghi {
+  enum class Rise { linear, smoothstep };
   SaturatedColumn col;
   double load = 0.0;  // q, Pa (compression positive)
   double ramp = 0.0;  // s
+  Rise rise = Rise::linear;
 
-  // Ramp average of exp(-a (t - s)) over the loading history, times the load fraction.
+  /// Load fraction f(t) in [0, 1].
+  double fraction(double t) const {
+    if (ramp <= 0.0) return t >= 0.0 ? 1.0 : 0.0;
+    const double s = std::clamp(t / ramp, 0.0, 1.0);
+    return rise == Rise::linear ? s : s * s * s * (10.0 - 15.0 * s + 6.0 * s * s);
+  }
+
+  /// The load history's weight on exp(-a (t - tau)): the integral of f'(tau) exp(-a (t - tau))
+  /// over 0 <= tau <= t (the mode's response to the history, per unit load).
   double ramp_factor(double a, double t) const {
     if (ramp <= 0.0) return std::exp(-a * t);
     if (t <= 0.0) return 0.0;
-    if (t < ramp) return -std::expm1(-a * t) / (a * ramp);
-    return std::exp(-a * (t - ramp)) * (-std::expm1(-a * ramp)) / (a * ramp);
+    if (rise == Rise::linear) {
+      if (t < ramp) return -std::expm1(-a * t) / (a * ramp);
+      return std::exp(-a * (t - ramp)) * (-std::expm1(-a * ramp)) / (a * ramp);
+    }
+    // Smoothstep: f'(tau) = g(s)/ramp with g(s) = 30 s^2 (1 - s)^2, s = tau/ramp. In s the
+    // integral is that of g(s) exp(-b (theta - s)) over [0, m], b = a ramp, theta = t/ramp.
+    const double b = a * ramp, theta = t / ramp, m = std::min(theta, 1.0);
+    auto g = [](double s) { return 30.0 * s * s * (1.0 - s) * (1.0 - s); };
+    if (b < 1.0) {
+      // Small b: Gauss-Legendre on [0, m] (10 points: exact for degree 19; the exponential's
+      // Taylor tail beyond that is below 1e-16 for b < 1).
+      const auto& gl = gauss_legendre10();
+      double sum = 0.0;
+      for (std::size_t k = 0; k < gl.size(); ++k) {
+        const double s = 0.5 * m * (1.0 + gl[k][0]);
+        sum += gl[k][1] * g(s) * std::exp(-b * (theta - s));
+      }
+      return 0.5 * m * sum;
+    }
+    // b >= 1: integrate by parts to the end, e^{bs} sum_k (-1)^k g^(k)(s) / b^(k+1) (g is a
+    // quartic), without the cancellation that the same sum suffers at small b.
+    auto derivatives = [](double s) {
+      return std::array<double, 5>{30.0 * s * s * (1.0 - s) * (1.0 - s), 60.0 * s - 180.0 * s * s + 120.0 * s * s * s,
+                                   60.0 - 360.0 * s + 360.0 * s * s, -360.0 + 720.0 * s, 720.0};
+    };
+    const auto dm = derivatives(m), d0 = derivatives(0.0);
+    const double em = std::exp(-b * (theta - m)), e0 = std::exp(-b * theta);
+    double sum = 0.0, bk = b, sign = 1.0;
+    for (std::size_t k = 0; k < 5; ++k, bk *= b, sign = -sign) sum += sign * (dm[k] * em - d0[k] * e0) / bk;
+    return sum;
+  }
+
+  /// Nodes (on [-1, 1]) and weights of the 10-point Gauss-Legendre rule, by Newton's iteration
+  /// on P_10.
+  static const std::array<std::array<double, 2>, 10>& gauss_legendre10() {
+    static const std::array<std::array<double, 2>, 10> rule = [] {
+      std::array<std::array<double, 2>, 10> r{};
+      constexpr int n = 10;
+      for (int i = 0; i < n; ++i) {
+        double x = std::cos(std::numbers::pi * (i + 0.75) / (n + 0.5)), dp = 0.0;
+        for (int it = 0; it < 100; ++it) {
+          double p0 = 1.0, p1 = x;
+          for (int k = 2; k <= n; ++k) {
+            const double pk = ((2.0 * k - 1.0) * x * p1 - (k - 1.0) * p0) / k;
+            p0 = p1;
+            p1 = pk;
+          }
+          dp = n * (x * p1 - p0) / (x * x - 1.0);
+          const double dx = p1 / dp;
+          x -= dx;
+          if (std::abs(dx) < 1e-16) break;
+        }
+        r[static_cast<std::size_t>(i)] = {x, 2.0 / ((1.0 - x * x) * dp * dp)};
+      }
+      return r;
+    }();
+    return rule;
   }
   /// p_w(z, t), Pa.
   double pressure(double z, double t) const {
@@ -61,15 +128,15 @@ struct Terzaghi {
       const double a = Mm * Mm * col.cv() / (H * H);
       s += 2.0 / (Mm * Mm) * ramp_factor(a, t);
     }
-    const double fraction = ramp > 0.0 ? std::min(t / ramp, 1.0) : 1.0;
-    return fraction > 0.0 ? 1.0 - s / fraction : 0.0;
+    const double f = fraction(t);
+    return f > 0.0 ? 1.0 - s / f : 0.0;
   }
   /// Settlement S(t) = S0 + (S_inf - S0) U, with the ramp, m.
   double settlement(double t) const {
-    const double fraction = ramp > 0.0 ? std::min(t / ramp, 1.0) : 1.0;
+    const double f = fraction(t);
     const double s0 = load * col.height / (col.constrained + col.storage);
     const double sinf = load * col.height / col.constrained;
-    return fraction * (s0 + (sinf - s0) * degree(t));
+    return f * (s0 + (sinf - s0) * degree(t));
   }
   double final_settlement() const { return load * col.height / col.constrained; }
 };

@@ -311,6 +311,51 @@ TEST(Saturated, DrainedLimitReducesToV1) {
   EXPECT_LT(previous, 0.01);
 }
 
+// The Terzaghi reference of Case 13 under a smoothstep load: each mode's convolution with the
+// load history (both branches: Gauss-Legendre for a ramp < 1, integration by parts above)
+// against a fine composite Simpson sum, during and after the rise; and the linear ramp against
+// its own closed form the same way.
+TEST(Saturated, TerzaghiReferenceConvolvesTheLoadHistoryExactly) {
+  analytic::SaturatedColumn col;
+  col.constrained = 3.0e7 * 0.8 / (1.2 * 0.6);
+  col.storage = 1.0e8 / 0.3;
+  col.permeability = 1.0e-3 / (1000.0 * 9.81);
+  col.density = 1700.0;
+  for (const auto rise : {analytic::Terzaghi::Rise::linear, analytic::Terzaghi::Rise::smoothstep}) {
+    const analytic::Terzaghi ref{col, 5.0e3, 0.5, rise};
+    for (double a : {1e-3, 0.0762, 1.0, 1.99, 2.01, 7.0, 60.0, 4.9e4}) {
+      for (double t : {0.1, 0.25, 0.49, 0.5, 0.8, 3.0}) {
+        // Simpson over tau in [0, min(t, ramp)] of f'(tau) exp(-a (t - tau)), f' by central differences
+        // of the load fraction is not accurate enough: use its closed form.
+        auto dfdt = [&](double tau) {
+          const double s = tau / 0.5;
+          return rise == analytic::Terzaghi::Rise::linear ? 1.0 / 0.5 : 30.0 * s * s * (1.0 - s) * (1.0 - s) / 0.5;
+        };
+        const double end = std::min(t, 0.5);
+        const int n = 200000;
+        const double h = end / n;
+        double sum = 0.0;
+        for (int i = 0; i <= n; ++i) {
+          const double w = (i == 0 || i == n) ? 1.0 : (i % 2 == 1 ? 4.0 : 2.0);
+          const double tau = i * h;
+          sum += w * dfdt(tau) * std::exp(-a * (t - tau));
+        }
+        sum *= h / 3.0;
+        EXPECT_NEAR(ref.ramp_factor(a, t), sum, 1e-10 * std::max(1.0, std::abs(sum)))
+            << "rise " << static_cast<int>(rise) << ", a = " << a << ", t = " << t;
+      }
+    }
+    // Fully loaded and fully drained: no pressure, the final settlement; at a = 0 the history's
+    // weight is the load fraction.
+    EXPECT_NEAR(ref.ramp_factor(1e-12, 0.3), ref.fraction(0.3), 1e-9);
+    EXPECT_NEAR(ref.pressure(5.0, 1e4), 0.0, 1e-9);
+    EXPECT_NEAR(ref.settlement(1e4) / ref.final_settlement(), 1.0, 1e-9);
+  }
+  const analytic::Terzaghi smooth{col, 5.0e3, 0.5, analytic::Terzaghi::Rise::smoothstep};
+  EXPECT_DOUBLE_EQ(smooth.fraction(0.25), 0.5);
+  EXPECT_DOUBLE_EQ(smooth.fraction(0.6), 1.0);
+}
+
 TEST(Saturated, TwoDimensionalStripConsolidatesLikeTerzaghi) {
   // A 2D strip (0.6 m wide, 4 m high, lateral rollers and impermeable walls) is a 1D column:
   // the mirror images at the side walls (laplacian.hpp) must leave the consolidation 1D.
