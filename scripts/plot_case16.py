@@ -73,7 +73,7 @@ def main(d):
         fig.colorbar(sc, ax=ax, label="$\\bar\\varepsilon^{vp}$ (-)", shrink=0.7)
         band = [i for i in idx if s["in_band"][i] > 0.5]
         if band and tag == "k1e-06":
-            ax.plot([s["x"][i] for i in band], [s["y"][i] for i in band], "r.", ms=2, label="band cloud (50 % of max)")
+            ax.plot([s["x"][i] for i in band], [s["y"][i] for i in band], "r.", ms=2, label="band cloud (50 % of the largest outside the imperfection)")
             ax.legend(fontsize=7, loc="lower right")
         ax.set_title(f"{lab}\n$\\bar\\varepsilon^{{vp}}$ at $\\varepsilon_a$ = {100 * st:.1f} %", fontsize=9)
         ax = axes[col + 1]

@@ -14,6 +14,22 @@ HistoryView node_history(const Simulation<2>& solver, const std::string& name, c
   return solver.node_history(name);
 }
 
+std::vector<char> imperfection_nodes(const Simulation<2>& solver) {
+  const auto& nodes = solver.nodes();
+  const auto nn = static_cast<std::size_t>(nodes.size());
+  std::vector<std::size_t> per_material;
+  for (std::size_t i = 0; i < nn; ++i) {
+    const auto m = static_cast<std::size_t>(nodes.material[i]);
+    if (m >= per_material.size()) per_material.resize(m + 1, 0);
+    ++per_material[m];
+  }
+  const auto sample =
+      static_cast<int>(std::max_element(per_material.begin(), per_material.end()) - per_material.begin());
+  std::vector<char> seed(nn, 0);
+  for (std::size_t i = 0; i < nn; ++i) seed[i] = nodes.material[i] != sample;
+  return seed;
+}
+
 namespace {
 
 // Principal axis (angle to the horizontal, degrees) of the nodes selected by `keep`, and the
@@ -47,9 +63,11 @@ std::pair<double, double> principal_axis(const std::vector<double>& x, const std
 }  // namespace
 
 BandFit fit_band(const std::vector<double>& x, const std::vector<double>& y, const std::vector<double>& eps,
-                 double height, double margin, double xi, double yi) {
+                 double height, double margin, double xi, double yi, const std::vector<char>& outside) {
   BandFit r;
-  auto inside = [&](std::size_t i) { return y[i] > margin + 1e-9 && y[i] < height - margin - 1e-9; };
+  auto inside = [&](std::size_t i) {
+    return y[i] > margin + 1e-9 && y[i] < height - margin - 1e-9 && (outside.empty() || outside[i] == 0);
+  };
   double emax = 0.0;
   for (std::size_t i = 0; i < x.size(); ++i) {
     if (inside(i)) emax = std::max(emax, eps[i]);

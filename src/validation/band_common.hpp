@@ -30,6 +30,10 @@ inline double platen_time(double strain) {
 /// materials carry no such variable.
 HistoryView node_history(const Simulation<2>& solver, const std::string& name, const std::string& who);
 
+/// The imperfection of the sample cases: the nodes of a material other than the sample's (the
+/// most common one), 1 per node.
+std::vector<char> imperfection_nodes(const Simulation<2>& solver);
+
 /// The band fitted to the cloud of nodes where eps >= 50 % of its maximum inside the band
 /// region (docs/cases.md §1.3).
 struct BandFit {
@@ -44,11 +48,12 @@ struct BandFit {
 };
 
 /// Band of the nodal field `eps` at positions (x, y). The band region is the sample without
-/// the `margin` next to each platen (y = 0 and y = height): the platen corners concentrate
-/// strain by the boundary, not by the band. A conjugate pair is fitted arm by arm, the arms
-/// being the parts of the cloud above and below its centroid; the whole-cloud axis is also
-/// given. (xi, yi) is the imperfection centre.
+/// the `margin` next to each platen (y = 0 and y = height) and without the nodes flagged in
+/// `outside` (the imperfection; empty: none): the platen corners concentrate strain by the
+/// boundary, the imperfection by its weaker material, neither by the band. A conjugate pair is fitted arm by arm, the
+/// arms being the parts of the cloud above and below its centroid; the whole-cloud axis is also given. (xi, yi) is the
+/// imperfection centre.
 BandFit fit_band(const std::vector<double>& x, const std::vector<double>& y, const std::vector<double>& eps,
-                 double height, double margin, double xi, double yi);
+                 double height, double margin, double xi, double yi, const std::vector<char>& outside = {});
 
 }  // namespace rktsph::validation

@@ -1,0 +1,54 @@
+// The band angle of docs/cases.md §1.3 as Cases 3 and 16 measure it (validation/band_common.hpp):
+// on a synthetic sample with a strongly strained imperfection and two weaker arms from it at a
+// known angle, the band region without the imperfection gives the arms' angle; with it, the
+// 50 % threshold sees only the imperfection, as the cases' former measure did.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+#include "validation/band_common.hpp"
+
+namespace rktsph::validation {
+namespace {
+
+TEST(BandFit, TheImperfectionOutsideTheBandRegionLeavesTheArms) {
+  const double dx = 0.02, angle = 50.0 * std::numbers::pi / 180.0;
+  const double xi = 0.04, yi = 1.0;  // imperfection centre, as in the cases
+  std::vector<double> x, y, eps;
+  std::vector<char> seed;
+  for (double px = 0.0; px <= 1.0 + 1e-9; px += dx) {
+    for (double py = 0.0; py <= 2.0 + 1e-9; py += dx) {
+      x.push_back(px);
+      y.push_back(py);
+      const bool in_seed = px <= 0.08 + 1e-9 && std::abs(py - yi) <= 0.04 + 1e-9;
+      seed.push_back(in_seed ? 1 : 0);
+      // Two arms ("<" opening to the right): distance from the lines through the centre at
+      // +-angle, strain 0.3 within a band 2.5 dx wide, a smooth background; the seed at 1.0.
+      const double du = std::abs(-(px - xi) * std::sin(angle) + (py - yi) * std::cos(angle));
+      const double dl = std::abs((px - xi) * std::sin(angle) + (py - yi) * std::cos(angle));
+      double e = 0.01 + 0.002 * px;
+      if (px > xi && std::min(du, dl) <= 1.25 * dx) e = 0.3;
+      if (in_seed) e = 1.0;
+      eps.push_back(e);
+    }
+  }
+  const BandFit with_seed = fit_band(x, y, eps, 2.0, 0.1, xi, yi);
+  EXPECT_LE(with_seed.particles, 25);  // the imperfection's nodes only
+  const BandFit arms = fit_band(x, y, eps, 2.0, 0.1, xi, yi, seed);
+  EXPECT_GT(arms.particles, 100);
+  EXPECT_TRUE(arms.pair);
+  EXPECT_NEAR(arms.upper, 50.0, 1.5);
+  EXPECT_NEAR(arms.lower, 50.0, 1.5);
+  EXPECT_NEAR(arms.angle, 50.0, 1.0);
+  EXPECT_LT(arms.offset, 2.0 * dx);
+  for (std::size_t i = 0; i < seed.size(); ++i) {
+    if (seed[i] != 0) {
+      EXPECT_EQ(arms.in_band[i], 0) << "node " << i;
+    }
+  }
+}
+
+}  // namespace
+}  // namespace rktsph::validation
