@@ -10,6 +10,8 @@
 
 #include <Eigen/Dense>
 
+#include "bc/time_function.hpp"
+
 namespace rktsph::analytic {
 
 /// Column constants shared by both cases (docs/cases.md C4 and Case 13).
@@ -32,17 +34,16 @@ struct SaturatedColumn {
 /// file's "ramp" and "smoothstep" functions): the step solution convolved exactly with the load
 /// history (ramp = 0: a step).
 struct Terzaghi {
-  enum class Rise { linear, smoothstep };
   SaturatedColumn col;
   double load = 0.0;  // q, Pa (compression positive)
   double ramp = 0.0;  // s
-  Rise rise = Rise::linear;
+  /// The rise: TimeFunction::Kind::ramp (linear) or ::smoothstep.
+  TimeFunction::Kind rise = TimeFunction::Kind::ramp;
 
-  /// Load fraction f(t) in [0, 1].
+  /// Load fraction f(t) in [0, 1], the case file's function itself.
   double fraction(double t) const {
     if (ramp <= 0.0) return t >= 0.0 ? 1.0 : 0.0;
-    const double s = std::clamp(t / ramp, 0.0, 1.0);
-    return rise == Rise::linear ? s : s * s * s * (10.0 - 15.0 * s + 6.0 * s * s);
+    return (rise == TimeFunction::Kind::smoothstep ? TimeFunction::smoothstep(ramp) : TimeFunction::ramp(ramp))(t);
   }
 
   /// The load history's weight on exp(-a (t - tau)): the integral of f'(tau) exp(-a (t - tau))
@@ -50,7 +51,7 @@ struct Terzaghi {
   double ramp_factor(double a, double t) const {
     if (ramp <= 0.0) return std::exp(-a * t);
     if (t <= 0.0) return 0.0;
-    if (rise == Rise::linear) {
+    if (rise != TimeFunction::Kind::smoothstep) {
       if (t < ramp) return -std::expm1(-a * t) / (a * ramp);
       return std::exp(-a * (t - ramp)) * (-std::expm1(-a * ramp)) / (a * ramp);
     }

@@ -43,7 +43,6 @@ struct ElasticPath {
 struct Snapshot {
   double strain = 0.0;
   std::vector<double> x, y, eps, q, vx, vy;
-  std::vector<char> seed;  // the imperfection's nodes
 };
 
 struct SampleResult {
@@ -53,6 +52,7 @@ struct SampleResult {
   double q_peak = 0.0, strain_peak = 0.0, q_end = 0.0, q_at_6 = NAN;
   double slope = NAN;  // fitted dq/d eps_a for 0.2 q_y <= q <= 0.8 q_y
   std::vector<Snapshot> snaps;
+  std::vector<char> seed;                      // the imperfection's nodes
   double band_angle = NAN, band_offset = NAN;  // degrees; distance of the band axis from the imperfection, m
   double band_angle_whole = NAN, band_angle_upper = NAN, band_angle_lower = NAN;  // degrees
   double band_angle_with_seed = NAN;  // the imperfection inside the band region (the measure before December 2026)
@@ -70,7 +70,7 @@ void band_angle(const Snapshot& s, SampleResult& r) {
   const BandFit seeded = fit_band(s.x, s.y, s.eps, kHeight, 0.1, 0.04, 1.0);
   r.band_angle_with_seed = seeded.angle;
   r.band_particles_with_seed = seeded.particles;
-  const BandFit b = fit_band(s.x, s.y, s.eps, kHeight, 0.1, 0.04, 1.0, s.seed);
+  const BandFit b = fit_band(s.x, s.y, s.eps, kHeight, 0.1, 0.04, 1.0, r.seed);
   r.band_particles = b.particles;
   r.band_angle_whole = b.whole;
   r.band_angle_upper = b.upper;
@@ -99,7 +99,6 @@ SampleResult run_sample(const std::string& case_file, double dx, double end_stra
   const auto& nodes = solver.nodes();
   const auto nn = static_cast<std::size_t>(nodes.size());
   const HistoryView eps_of = node_history(solver, "eps_vp_eq", "case 3");
-  const std::vector<char> seed = imperfection_nodes(solver);
   auto q_of = [&](std::size_t i) { return solver.node_stress().invariants(i).q; };
   std::vector<std::size_t> top;
   double volume = 0.0;
@@ -110,6 +109,7 @@ SampleResult run_sample(const std::string& case_file, double dx, double end_stra
 
   SampleResult out;
   out.dx = dx;
+  out.seed = imperfection_nodes(solver);
   const long steps = static_cast<long>(std::ceil(t_end / solver.dt()));
   const long record_every = std::max(1L, steps / 2000);
   std::size_t next_snap = 0;
@@ -169,7 +169,6 @@ SampleResult run_sample(const std::string& case_file, double dx, double end_stra
     while (next_snap < snap_strains.size() && strain >= snap_strains[next_snap] - 1e-12) {
       Snapshot s;
       s.strain = strain;
-      s.seed = seed;
       for (std::size_t i = 0; i < nn; ++i) {
         s.x.push_back(nodes.position[i][0]);
         s.y.push_back(nodes.position[i][1]);

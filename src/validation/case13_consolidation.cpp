@@ -46,9 +46,7 @@ analytic::Terzaghi reference13(const CaseSetup<1>& setup, const std::string& cas
         (f.kind != TimeFunction::Kind::ramp && f.kind != TimeFunction::Kind::smoothstep)) {
       throw SolverError(case_file + ": case 13's load must rise by a \"ramp\" or \"smoothstep\" from t = 0 to 1");
     }
-    return analytic::Terzaghi{
-        column13(), kQ, f.duration,
-        f.kind == TimeFunction::Kind::ramp ? analytic::Terzaghi::Rise::linear : analytic::Terzaghi::Rise::smoothstep};
+    return analytic::Terzaghi{column13(), kQ, f.duration, f.kind};
   }
   throw SolverError(case_file + ": case 13 has no loaded face");
 }

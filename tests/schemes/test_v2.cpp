@@ -352,12 +352,6 @@ TEST(V2Sort, SortedRunIsBitIdenticalOnOneAndTwoThreads) {
   EXPECT_EQ(0, std::memcmp(one.first.data(), two.first.data(), one.first.size() * sizeof(double)));
 }
 
-}  // namespace
-}  // namespace rktsph
-
-namespace rktsph {
-namespace {
-
 // A resume restores the checkpoint's storage order and the Verlet reference, so a run sorted at
 // every search continues bit for bit (sorting at the same steps as the uninterrupted run).
 TEST(V2Sort, ASortedRunResumesBitForBit) {

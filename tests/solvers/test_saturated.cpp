@@ -321,7 +321,7 @@ TEST(Saturated, TerzaghiReferenceConvolvesTheLoadHistoryExactly) {
   col.storage = 1.0e8 / 0.3;
   col.permeability = 1.0e-3 / (1000.0 * 9.81);
   col.density = 1700.0;
-  for (const auto rise : {analytic::Terzaghi::Rise::linear, analytic::Terzaghi::Rise::smoothstep}) {
+  for (const auto rise : {TimeFunction::Kind::ramp, TimeFunction::Kind::smoothstep}) {
     const analytic::Terzaghi ref{col, 5.0e3, 0.5, rise};
     for (double a : {1e-3, 0.0762, 1.0, 1.99, 2.01, 7.0, 60.0, 4.9e4}) {
       for (double t : {0.1, 0.25, 0.49, 0.5, 0.8, 3.0}) {
@@ -329,7 +329,7 @@ TEST(Saturated, TerzaghiReferenceConvolvesTheLoadHistoryExactly) {
         // of the load fraction is not accurate enough: use its closed form.
         auto dfdt = [&](double tau) {
           const double s = tau / 0.5;
-          return rise == analytic::Terzaghi::Rise::linear ? 1.0 / 0.5 : 30.0 * s * s * (1.0 - s) * (1.0 - s) / 0.5;
+          return rise == TimeFunction::Kind::ramp ? 1.0 / 0.5 : 30.0 * s * s * (1.0 - s) * (1.0 - s) / 0.5;
         };
         const double end = std::min(t, 0.5);
         const int n = 200000;
@@ -351,7 +351,7 @@ TEST(Saturated, TerzaghiReferenceConvolvesTheLoadHistoryExactly) {
     EXPECT_NEAR(ref.pressure(5.0, 1e4), 0.0, 1e-9);
     EXPECT_NEAR(ref.settlement(1e4) / ref.final_settlement(), 1.0, 1e-9);
   }
-  const analytic::Terzaghi smooth{col, 5.0e3, 0.5, analytic::Terzaghi::Rise::smoothstep};
+  const analytic::Terzaghi smooth{col, 5.0e3, 0.5, TimeFunction::Kind::smoothstep};
   EXPECT_DOUBLE_EQ(smooth.fraction(0.25), 0.5);
   EXPECT_DOUBLE_EQ(smooth.fraction(0.6), 1.0);
 }
