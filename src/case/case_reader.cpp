@@ -403,6 +403,26 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
                  "sorting the particles needs solver.version = \"v2\" (fixed particles keep the lattice's order, "
                  "which their operators' shared rows rely on)");
     }
+    // After velocity_update and filter, which decide "auto".
+    const bool filtered = !c.simple_velocity && c.filter;
+    const std::string operators = s->string("operators", "auto");
+    if (operators == "auto") {
+      c.operators_on_the_fly = !filtered;
+    } else if (operators == "on_the_fly") {
+      s->require(!filtered, "operators",
+                 "\"on_the_fly\" cannot serve V1's velocity filter, which applies the stored operators "
+                 "(velocity_update = \"taylor_galerkin\" with filter = true): use \"stored\" or \"auto\"");
+      c.operators_on_the_fly = true;
+    } else if (operators == "stored") {
+      c.operators_on_the_fly = false;
+    } else {
+      s->fail("operators", fmt::format("unknown value '{}' (known: auto, on_the_fly, stored)", operators));
+    }
+    if (s->has("operators")) {
+      s->require(c.version == "v2", "operators",
+                 "the operators' storage is a choice of solver.version = \"v2\" (fixed particles store theirs "
+                 "once, as shared rows)");
+    }
     if (s->has("domain_min") || s->has("domain_max")) {
       if (!s->has("domain_min")) s->fail("domain_max", "needs solver.domain_min as well (the box's lower corner)");
       if (!s->has("domain_max")) s->fail("domain_min", "needs solver.domain_max as well (the box's upper corner)");

@@ -276,6 +276,12 @@ struct CaseSetup {
   /// §3.8, "Storage order"; solver.sort): never, at a neighbour search once the storage order
   /// has become disordered (the mean index gap of neighbour pairs doubled), or at every search.
   SortSetting sort = SortSetting::automatic;
+  /// V2: the corrected operators applied on the fly in the steps, from the current positions,
+  /// without storing a weight per pair (method-notes §5.2, "Operators on the fly"), or stored
+  /// as weights rebuilt at the start of every step (solver.operators = "on_the_fly" |
+  /// "stored"; "auto" is on the fly unless V1's velocity filter, which applies the stored
+  /// operators, is on).
+  bool operators_on_the_fly = true;
   /// V2: the domain box [min, max] (solver.domain_min / domain_max): particles that leave it
   /// are deactivated (schemes/deactivate_stage.hpp); empty: no box. `domain_where` names the
   /// keys' file and line for the errors found once the particles exist.

@@ -14,6 +14,7 @@
 #include "core/error.hpp"
 #include "core/execution.hpp"
 #include "neighbours/cell_list.hpp"
+#include "operators/corrected_row.hpp"
 #include "operators/row_pairs.hpp"
 
 namespace rktsph {
@@ -190,128 +191,6 @@ bool row_weights(const std::vector<Pair<Dim>>& pairs, const ParticleSet<Dim>& so
   return ok;
 }
 
-// The pairs of one row for the rebuild of moving particles (rebuild_corrected_operator), as a
-// structure of arrays: the row's candidates inside the support are gathered by a branch-free
-// compaction, then the kernel, the moment matrix and the weights are computed in loops over
-// the pairs that the compiler vectorises (`omp simd`): the square root, the division and the
-// choice of the kernel's piece run 8 pairs at a time instead of one (AVX-512), with no
-// mispredicted branch. Kept per thread from call to call (no allocation once grown).
-template <int Dim>
-struct RowArrays {
-  static constexpr int N = Dim + 1;
-  std::vector<Index> source;
-  std::vector<double> x_ab[Dim];  // x_a - x_b
-  std::vector<double> d2;         // |x_a - x_b|^2
-  std::vector<double> volume;
-  std::vector<double> basis[N];  // V_b [W_ab; h grad_a W_ab]
-  std::size_t n = 0;
-
-  void reserve(std::size_t m) {
-    if (source.size() >= m) return;
-    source.resize(m);
-    for (auto& v : x_ab) v.resize(m);
-    d2.resize(m);
-    volume.resize(m);
-    for (auto& v : basis) v.resize(m);
-  }
-
-  // The candidates of row a with |x_a - x_b|^2 < r2, in row order (the same test as the count).
-  void gather(std::span<const Index> candidates, const Vec<Dim>& xa, const ParticleSet<Dim>& sources, double r2) {
-    reserve(candidates.size());
-    std::size_t count = 0;
-    for (const Index b : candidates) {
-      const auto bu = static_cast<std::size_t>(b);
-      const Vec<Dim> x = xa - sources.position[bu];
-      const double s = x.squaredNorm();
-      source[count] = b;
-      for (int d = 0; d < Dim; ++d) x_ab[d][count] = x[d];
-      d2[count] = s;
-      volume[count] = sources.volume[bu];
-      count += s < r2 ? 1 : 0;
-    }
-    n = count;
-  }
-};
-
-// The weights of the gathered row (the system of row_weights): writes interp[k] and grad[k] of
-// its n pairs; returns false if the row is degenerate (then Shepard interpolation and the plain
-// kernel gradient).
-template <int Dim>
-bool row_weights_arrays(RowArrays<Dim>& row, const CubicSplineKernel<Dim>& kernel, double* interp,
-                        std::array<double, Dim>* grad) {
-  constexpr int N = Dim + 1;
-  using MatN = Eigen::Matrix<double, N, N>;
-  const double inv_h = kernel.inv_h(), alpha = kernel.alpha();
-  const std::size_t n = row.n;
-  const double* d2 = row.d2.data();
-  const double* V = row.volume.data();
-  const double* x[Dim];
-  double* w[N];
-  for (int d = 0; d < Dim; ++d) x[d] = row.x_ab[d].data();
-  for (int i = 0; i < N; ++i) w[i] = row.basis[i].data();
-    // The basis V_b [W_ab; h grad_a W_ab] (grad_a W_ab = W'/r x_ab).
-#pragma omp simd
-  for (std::size_t k = 0; k < n; ++k) {
-    double W, g;
-    CubicSplineKernel<Dim>::value_and_scaled_derivative(std::sqrt(d2[k]), inv_h, alpha, W, g);
-    w[0][k] = V[k] * W;
-    for (int d = 0; d < Dim; ++d) w[1 + d][k] = V[k] * g * x[d][k];
-  }
-  // M = sum_b w (x) [1, (x_b - x_a)/h]: in 2D its nine sums in one vectorised pass (nine
-  // vector accumulators); otherwise one entry at a time, each a vectorised dot product.
-  MatN M;
-  if constexpr (Dim == 2) {
-    const double *w0 = w[0], *w1 = w[1], *w2 = w[2], *x0 = x[0], *x1 = x[1];
-    double s00 = 0, s01 = 0, s02 = 0, s10 = 0, s11 = 0, s12 = 0, s20 = 0, s21 = 0, s22 = 0;
-#pragma omp simd reduction(+ : s00, s01, s02, s10, s11, s12, s20, s21, s22)
-    for (std::size_t k = 0; k < n; ++k) {
-      s00 += w0[k], s01 += w0[k] * x0[k], s02 += w0[k] * x1[k];
-      s10 += w1[k], s11 += w1[k] * x0[k], s12 += w1[k] * x1[k];
-      s20 += w2[k], s21 += w2[k] * x0[k], s22 += w2[k] * x1[k];
-    }
-    M << s00, -s01 * inv_h, -s02 * inv_h, s10, -s11 * inv_h, -s12 * inv_h, s20, -s21 * inv_h, -s22 * inv_h;
-  } else {
-    for (int i = 0; i < N; ++i) {
-      const double* wi = w[i];
-      double s0 = 0.0;
-#pragma omp simd reduction(+ : s0)
-      for (std::size_t k = 0; k < n; ++k) s0 += wi[k];
-      M(i, 0) = s0;
-      for (int d = 0; d < Dim; ++d) {
-        const double* xd = x[d];
-        double s = 0.0;
-#pragma omp simd reduction(+ : s)
-        for (std::size_t k = 0; k < n; ++k) s += wi[k] * xd[k];
-        M(i, 1 + d) = -s * inv_h;
-      }
-    }
-  }
-  const double shepard = M(0, 0);
-  const bool ok = n > 0 && std::abs(M.determinant()) > 1e-8;
-  if (ok) {
-    const MatN Minv = M.inverse();
-    double m[N][N];
-    for (int i = 0; i < N; ++i)
-      for (int j = 0; j < N; ++j) m[i][j] = Minv(i, j);
-#pragma omp simd
-    for (std::size_t k = 0; k < n; ++k) {
-      double c[N];
-      for (int i = 0; i < N; ++i) {
-        c[i] = 0.0;
-        for (int j = 0; j < N; ++j) c[i] += m[i][j] * w[j][k];
-      }
-      interp[k] = c[0];
-      for (int d = 0; d < Dim; ++d) grad[k][static_cast<std::size_t>(d)] = c[d + 1] * inv_h;
-    }
-  } else {
-    for (std::size_t k = 0; k < n; ++k) {
-      interp[k] = shepard > 0.0 ? w[0][k] / shepard : 0.0;
-      for (int d = 0; d < Dim; ++d) grad[k][static_cast<std::size_t>(d)] = w[1 + d][k] * inv_h;
-    }
-  }
-  return ok;
-}
-
 }  // namespace
 
 template <int Dim>
@@ -469,22 +348,24 @@ void rebuild_corrected_operator(const Relation<Dim>& candidates, const std::vect
       policy, nblocks,
       [&](Index blk) {
         // Work space of this thread, kept from call to call (no allocation once grown).
-        static thread_local RowArrays<Dim> row;
+        static thread_local CorrectedRow<Dim> row;
         const Index end = std::min(nt, (blk + 1) * kBuildBlock);
         for (Index a = blk * kBuildBlock; a < end; ++a) {
           const auto au = static_cast<std::size_t>(a);
-          row.gather(candidates.row(a), targets[au], sources, r2);
+          if (!row.evaluate(candidates.row(a), targets[au], sources.position.data(), sources.volume.data(), kernel,
+                            r2)) {
+            degenerate.fetch_add(1, std::memory_order_relaxed);
+          }
           const auto k0 = static_cast<std::size_t>(op.pattern_start[au]);
-          if (row.n != static_cast<std::size_t>(op.pattern_start[au + 1]) - k0) {
+          if (row.size() != static_cast<std::size_t>(op.pattern_start[au + 1]) - k0) {
             mismatch.store(true, std::memory_order_relaxed);
             continue;
           }
-          if (!row_weights_arrays<Dim>(row, kernel, &op.interp[k0], &op.grad[k0])) {
-            degenerate.fetch_add(1, std::memory_order_relaxed);
-          }
-          const Index b0 = row.n > 0 ? row.source[0] : 0;
+          row.weights(&op.interp[k0], &op.grad[k0]);
+          const Index* src = row.sources();
+          const Index b0 = row.size() > 0 ? src[0] : 0;
           op.base[au] = b0;
-          for (std::size_t j = 0; j < row.n; ++j) op.offset[k0 + j] = row.source[j] - b0;
+          for (std::size_t j = 0; j < row.size(); ++j) op.offset[k0 + j] = src[j] - b0;
         }
       },
       exec::Schedule::dynamic, nt);

@@ -64,8 +64,9 @@ struct CorrectedOperator {
   };
 
   Index rows() const { return static_cast<Index>(base.size()); }
-  Index patterns() const { return static_cast<Index>(pattern_start.size()) - 1; }
-  Index runs() const { return static_cast<Index>(run_start.size()) - 1; }
+  // An empty operator (V2 applies its operators on the fly and stores none) has no patterns.
+  Index patterns() const { return pattern_start.empty() ? 0 : static_cast<Index>(pattern_start.size()) - 1; }
+  Index runs() const { return run_start.empty() ? 0 : static_cast<Index>(run_start.size()) - 1; }
   std::size_t pairs() const { return pair_count; }
   Row row(Index a) const {
     const auto p = static_cast<std::size_t>(pattern[static_cast<std::size_t>(a)]);

@@ -25,25 +25,47 @@ template <int Dim>
 Index ReseedStressPoints<Dim>::uncovered() const {
   const double limit = m_.setup.reseed_distance * m_.dx();
   const double limit2 = limit * limit;
-  auto count = [this, limit2](const CorrectedOperator<Dim>& op, const std::vector<Vec<Dim>>& x,
-                              const std::vector<Vec<Dim>>& y) {
+  // rows(a, f) calls f(b) for each source b of row a.
+  auto count = [this, limit2](Index targets, const std::vector<Vec<Dim>>& x, const std::vector<Vec<Dim>>& y,
+                              auto&& rows) {
     // An integer sum: the same whatever the threads' order.
     std::atomic<Index> n{0};
-    exec::particle_for(m_.policy, op.rows(), [&](Index a) {
-      const auto row = op.row(a);
+    exec::particle_for(m_.policy, targets, [&](Index a) {
       double nearest = std::numeric_limits<double>::infinity();
-      for (Index k = row.begin; k < row.end; ++k) {
-        nearest = std::min(
-            nearest, (x[static_cast<std::size_t>(a)] - y[static_cast<std::size_t>(op.source(row, k))]).squaredNorm());
-      }
+      rows(a, [&](Index b) {
+        nearest = std::min(nearest, (x[static_cast<std::size_t>(a)] - y[static_cast<std::size_t>(b)]).squaredNorm());
+      });
       if (nearest > limit2) n.fetch_add(1, std::memory_order_relaxed);
     });
     return n.load();
   };
+  const auto& xn = m_.nodes.position;
+  const auto& xs = m_.stress_points.position;
+  if (moving_ != nullptr && moving_->on_the_fly) {
+    // The candidates within the support at the positions now: the same nearest particle as the
+    // rows of the step (reseed_distance <= 2 dx lies inside the support by more than a step's
+    // motion).
+    const double r2 = moving_->r2;
+    auto within = [r2](const Relation<Dim>& rel, const std::vector<Vec<Dim>>& x, const std::vector<Vec<Dim>>& y) {
+      return [&rel, &x, &y, r2](Index a, auto&& f) {
+        for (const Index b : rel.row(a)) {
+          if ((x[static_cast<std::size_t>(a)] - y[static_cast<std::size_t>(b)]).squaredNorm() < r2) f(b);
+        }
+      };
+    };
+    return count(m_.nodes.size(), xn, xs, within(*moving_->stress_points_near_nodes, xn, xs)) +
+           count(m_.stress_points.size(), xs, xn, within(*moving_->nodes_near_stress_points, xs, xn));
+  }
+  auto stored = [](const CorrectedOperator<Dim>& op) {
+    return [&op](Index a, auto&& f) {
+      const auto row = op.row(a);
+      for (Index k = row.begin; k < row.end; ++k) f(op.source(row, k));
+    };
+  };
   // The operators of the step just ended; the particles have moved since by a fraction of dx,
   // well inside the margin between the limit and the support.
-  return count(m_.to_nodes, m_.nodes.position, m_.stress_points.position) +
-         count(m_.to_stress_points, m_.stress_points.position, m_.nodes.position);
+  return count(m_.to_nodes.rows(), xn, xs, stored(m_.to_nodes)) +
+         count(m_.to_stress_points.rows(), xs, xn, stored(m_.to_stress_points));
 }
 
 template <int Dim>

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "particles/reseed.hpp"
+#include "schemes/moving_operators.hpp"
 #include "schemes/stage.hpp"
 #include "schemes/staggered_model.hpp"
 
@@ -36,6 +37,9 @@ class ReseedStressPoints final : public Stage {
   /// the operators' supports) is farther than solver.reseed_distance * dx; a particle with
   /// none in its support counts too.
   Index uncovered() const;
+  /// With V2's operators on the fly the rows are not stored: uncovered() reads the steps'
+  /// candidate lists cut back to the support instead.
+  void set_moving_operators(const MovingOperators<Dim>* moving) { moving_ = moving; }
   /// At the end of a step (stage ReseedCheck), on the operators of the step and the positions
   /// at its end, as the next step starts: whether that step re-seeds ("auto"). The decision is
   /// kept in checkpoints, so that a resumed run decides as the uninterrupted one.
@@ -48,6 +52,7 @@ class ReseedStressPoints final : public Stage {
   void reseed(double t);
 
   StaggeredModel<Dim>& m_;
+  const MovingOperators<Dim>* moving_ = nullptr;
   ReseedOptions options_;
   std::int64_t next_global_id_ = 0;
   long reseeds_ = 0;

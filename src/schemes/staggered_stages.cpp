@@ -3,13 +3,33 @@
 #include "operators/free_surface.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <utility>
 
 #include "io/state_archive.hpp"
+#include "operators/corrected_row.hpp"
 #include "operators/run_sums.hpp"
 
 namespace rktsph {
+
+namespace {
+
+// Rows of the on-the-fly operators evaluated together: one thread's block (its pair and
+// degenerate counts summed once), and the unit the threads share out.
+constexpr Index kOnTheFlyBlock = 256;
+
+// A row's value (out[0]) and gradient (out[1 + d]) into the steps' layout: value[c] and
+// grad[d][c] = d f_c / d x_d.
+template <int Dim, int NF>
+inline void split_value_gradient(const double (&out)[Dim + 1][NF], double (&value)[NF], double (&grad)[Dim][NF]) {
+  for (int c = 0; c < NF; ++c) {
+    value[c] = out[0][c];
+    for (int d = 0; d < Dim; ++d) grad[d][c] = out[1 + d][c];
+  }
+}
+
+}  // namespace
 
 namespace {
 
@@ -115,6 +135,95 @@ void StressPointHalfStep<Dim, PressureTerm, Motion>::run(const StepContext& c) {
   ViscoplasticSources<Dim>& src = *sources_;
   if constexpr (Motion::kMoving) src.reserve(sp.size());  // re-seeded stress points (V2)
   const PressureTerm& pressure = pressure_;
+  // The update of stress point e from the interpolated nodal state (bar_v, bar_s), its gradient
+  // and, in V3, the pressure gradient; history(ks) writes the interpolated history variables.
+  auto update = [&](Index e, const double (&bar_v)[Dim], const double (&grad_v)[Dim][Dim], double (&bar_s)[NS],
+                    const double (&grad_s)[Dim][NS], [[maybe_unused]] const double* grad_p, auto&& history) {
+    const auto eu = static_cast<std::size_t>(e);
+    const int mat = sp.material[eu];
+    double dv[Dim], dsig[NS];
+    momentum_rate<Dim>(grad_s, 1.0 / sp.density[eu], dv);
+    // The moduli at the interpolated stress when they depend on it (method-notes eq. (1.8.8)).
+    m_.materials.elastic[static_cast<std::size_t>(mat)](grad_v, bar_s, dsig);
+    if constexpr (PressureTerm::kActive) {
+      // V3 (method-notes §5.3): -grad p^n / rho in the stress points' half step.
+      if (pressure.skeleton.data() != nullptr) {
+        for (int i = 0; i < Dim; ++i) pressure.skeleton(e, i) = damped_velocity(bar_v[i], dv[i] + b[i], cd, tau);
+      }
+      const double inv_rho = 1.0 / sp.density[eu];
+      for (int d = 0; d < Dim; ++d) dv[d] -= grad_p[d] * inv_rho;
+    }
+    for (int i = 0; i < Dim; ++i) sp_v(e, i) = damped_velocity(bar_v[i], dv[i] + b[i], cd, tau);
+    if constexpr (Motion::kMoving) {
+      // V2 (method-notes §1.3, §5.2): the Jaumann rotation of the interpolated stress over
+      // the half step (the flux and the source then act on the rotated stress); the
+      // density by continuity over the step, with d at t^n; the position with v^{n+1/2}.
+      jaumann_rotate<Dim>(grad_v, tau, bar_s);
+      double tr = 0.0;
+      for (int k = 0; k < Dim; ++k) tr += grad_v[k][k];
+      const double mass = sp.volume[eu] * sp.density[eu];
+      sp.density[eu] /= 1.0 + dt * tr;
+      sp.volume[eu] = mass / sp.density[eu];
+      for (int d = 0; d < Dim; ++d) sp.position[eu][d] += dt * sp_v(e, d);
+    }
+    for (int s = 0; s < NS; ++s) sp_s(e, s) = bar_s[s] + tau * dsig[s];
+    if (sources) {
+      double* start = src.sigma_start(e);
+      double* rate = src.flux_rate(e);
+      for (int s = 0; s < NS; ++s) {
+        start[s] = bar_s[s];
+        rate[s] = dsig[s];
+      }
+    }
+    // History variables are interpolated from the nodes (method-notes §3.3: nodes are primary).
+    if (stride > 0) history(sp_k[e]);
+  };
+  if constexpr (Motion::kMoving) {
+    if (moving_ != nullptr && moving_->on_the_fly) {
+      // V2, operators on the fly (method-notes §5.2): each stress point's row evaluated from its
+      // candidates at the positions of t^n, which are kept for step 2 before the row moves.
+      MovingOperators<Dim>& mo = *moving_;
+      mo.resize(sp.size());
+      const Relation<Dim>& candidates = *mo.nodes_near_stress_points;
+      const ParticleSet<Dim>& nodes = m_.nodes;
+      const Index nblocks = (sp.size() + kOnTheFlyBlock - 1) / kOnTheFlyBlock;
+      std::atomic<Index> degenerate{0};
+      std::atomic<std::size_t> pairs{0};
+      exec::particle_for(
+          m_.policy, nblocks,
+          [&](Index blk) {
+            static thread_local CorrectedRow<Dim> row;
+            Index block_degenerate = 0;
+            std::size_t block_pairs = 0;
+            const Index end = std::min(sp.size(), (blk + 1) * kOnTheFlyBlock);
+            for (Index e = blk * kOnTheFlyBlock; e < end; ++e) {
+              const auto eu = static_cast<std::size_t>(e);
+              if (!row.evaluate(candidates.row(e), sp.position[eu], nodes.position.data(), nodes.volume.data(),
+                                m_.kernel, mo.r2)) {
+                ++block_degenerate;
+              }
+              block_pairs += row.size();
+              mo.stress_point_position[eu] = sp.position[eu];
+              mo.stress_point_volume[eu] = sp.volume[eu];
+              double out_v[Dim + 1][Dim], out_s[Dim + 1][NS];
+              row.template apply<Dim>(node_v.data(), out_v);
+              row.template apply<NS>(node_s.data(), out_s);
+              double bar_v[Dim], bar_s[NS], grad_v[Dim][Dim], grad_s[Dim][NS];
+              split_value_gradient<Dim, Dim>(out_v, bar_v, grad_v);
+              split_value_gradient<Dim, NS>(out_s, bar_s, grad_s);
+              update(e, bar_v, grad_v, bar_s, grad_s, nullptr,
+                     [&](double* ks) { row.interpolate(node_k.data(), stride, ks); });
+            }
+            if (block_degenerate > 0) degenerate.fetch_add(block_degenerate, std::memory_order_relaxed);
+            pairs.fetch_add(block_pairs, std::memory_order_relaxed);
+          },
+          exec::Schedule::even, sp.size());
+      m_.to_stress_points.degenerate_rows = degenerate.load();
+      m_.to_stress_points.pair_count = pairs.load();
+      if (sources) src.integrate(tau, m_.stress_point_sources, sp_s, sp_k);
+      return;
+    }
+  }
   exec::particle_for(
       m_.policy, op.runs(),
       [&](Index r) {
@@ -140,52 +249,17 @@ void StressPointHalfStep<Dim, PressureTerm, Motion>::run(const StepContext& c) {
             bar_s[s] = acc_s[0][ss + static_cast<std::size_t>(s)];
             for (int d = 0; d < Dim; ++d) grad_s[d][s] = acc_s[1 + d][ss + static_cast<std::size_t>(s)];
           }
-          const auto eu = static_cast<std::size_t>(e);
-          const int mat = sp.material[eu];
-          double dv[Dim], dsig[NS];
-          momentum_rate<Dim>(grad_s, 1.0 / sp.density[eu], dv);
-          // The moduli at the interpolated stress when they depend on it (method-notes eq. (1.8.8)).
-          m_.materials.elastic[static_cast<std::size_t>(mat)](grad_v, bar_s, dsig);
+          [[maybe_unused]] double grad_p[Dim];
           if constexpr (PressureTerm::kActive) {
-            // V3 (method-notes §5.3): -grad p^n / rho in the stress points' half step.
-            if (pressure.skeleton.data() != nullptr) {
-              for (int i = 0; i < Dim; ++i) pressure.skeleton(e, i) = damped_velocity(bar_v[i], dv[i] + b[i], cd, tau);
-            }
-            const double inv_rho = 1.0 / sp.density[eu];
-            for (int d = 0; d < Dim; ++d) dv[d] -= acc_p[d][static_cast<std::size_t>(e - e0)] * inv_rho;
+            for (int d = 0; d < Dim; ++d) grad_p[d] = acc_p[d][static_cast<std::size_t>(e - e0)];
           }
-          for (int i = 0; i < Dim; ++i) sp_v(e, i) = damped_velocity(bar_v[i], dv[i] + b[i], cd, tau);
-          if constexpr (Motion::kMoving) {
-            // V2 (method-notes §1.3, §5.2): the Jaumann rotation of the interpolated stress over
-            // the half step (the flux and the source then act on the rotated stress); the
-            // density by continuity over the step, with d at t^n; the position with v^{n+1/2}.
-            jaumann_rotate<Dim>(grad_v, tau, bar_s);
-            double tr = 0.0;
-            for (int k = 0; k < Dim; ++k) tr += grad_v[k][k];
-            const double mass = sp.volume[eu] * sp.density[eu];
-            sp.density[eu] /= 1.0 + dt * tr;
-            sp.volume[eu] = mass / sp.density[eu];
-            for (int d = 0; d < Dim; ++d) sp.position[eu][d] += dt * sp_v(e, d);
-          }
-          for (int s = 0; s < NS; ++s) sp_s(e, s) = bar_s[s] + tau * dsig[s];
-          if (sources) {
-            double* start = src.sigma_start(e);
-            double* rate = src.flux_rate(e);
-            for (int s = 0; s < NS; ++s) {
-              start[s] = bar_s[s];
-              rate[s] = dsig[s];
-            }
-          }
-          if (stride > 0) {
-            // History variables are interpolated from the nodes (method-notes §3.3: nodes are
-            // primary).
-            double* ks = sp_k[e];
+          update(e, bar_v, grad_v, bar_s, grad_s, grad_p, [&](double* ks) {
             for (int j = 0; j < stride; ++j) ks[j] = 0.0;
             for (Index k = k0; k < k1; ++k) {
               const double* kn = node_k[base[e] + off[k]];
               for (int j = 0; j < stride; ++j) ks[j] += wi[k] * kn[j];
             }
-          }
+          });
         }
       },
       exec::Schedule::even, sp.size());
@@ -293,6 +367,140 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
   const DifferenceGradient<Dim>& diff = m_.constrained_gradient;
   const bool sources = sources_->active();
   ViscoplasticSources<Dim>& src = *sources_;
+  // The update of node i from the gradients of the stress points' state and their velocity
+  // interpolated back (v_half, the material velocity at t^{n+1/2}).
+  auto update = [&](Index i, double (&grad_v)[Dim][Dim], double (&grad_s)[Dim][NS], double (&v_half)[Dim]) {
+    const auto iu = static_cast<std::size_t>(i);
+    if (volumetric_rate_ != nullptr) {
+      // The stress points' divergence by the corrected gradient, before fix (a) replaces a
+      // prescribed component's gradient below (V3's storage equation, eq. (2.4.20)).
+      double tr = 0.0;
+      for (int k = 0; k < Dim; ++k) tr += grad_v[k][k];
+      volumetric_rate_[iu] = tr;
+    }
+    for (Index q = constraints.begin(i); q < constraints.end(i); ++q) {
+      const NodalConstraint& con = constraints[q];
+      if (con.component < Dim) v_half[con.component] = m_.constraint_value(i, con, t_half);
+    }
+    const Index drow = constraints.constrained_row(i);
+    if (drow >= 0) {
+      // method-notes §0.3 fix (a): a prescribed component enters its own gradient through
+      // the difference form with fhat = the prescribed value at t^{n+1/2}.
+      const auto dr = static_cast<std::size_t>(drow);
+      for (Index q = constraints.begin(i); q < constraints.end(i); ++q) {
+        const NodalConstraint& con = constraints[q];
+        const double fhat = m_.constraint_value(i, con, t_half);
+        const bool is_velocity = con.component < Dim;
+        const int comp = is_velocity ? con.component : con.component - Dim;
+        double g[Dim] = {};
+        for (Index k = diff.row_start[dr]; k < diff.row_start[dr + 1]; ++k) {
+          const Index e = diff.source[static_cast<std::size_t>(k)];
+          const double f = is_velocity ? sp_v(e, comp) : sp_s(e, comp);
+          for (int d = 0; d < Dim; ++d) g[d] += diff.weight[static_cast<std::size_t>(k)][d] * f;
+        }
+        for (int d = 0; d < Dim; ++d) {
+          const double value = g[d] - diff.weight_sum[dr][d] * fhat;
+          if (is_velocity) {
+            grad_v[d][comp] = value;
+          } else {
+            grad_s[d][comp] = value;
+          }
+        }
+      }
+    }
+    if (!m_.surface.row.empty() && m_.surface.row[iu] >= 0) {
+      surface_stress_gradient<Dim>(m_.surface, m_.surface.row[iu], sp_s, grad_s);
+      if (!m_.surface.traction.empty()) {
+        // A prescribed traction (polygon edges, method-notes §3.9): the difference form
+        // with fhat = the stress it prescribes, as fix (a) of §0.3 item 1.
+        const auto srow = static_cast<std::size_t>(m_.surface.row[iu]);
+        double prescribed[NS] = {};
+        m_.add_surface_traction(srow, t_half, prescribed);
+        for (int d = 0; d < Dim; ++d) {
+          for (int k = 0; k < NS; ++k) grad_s[d][k] -= m_.surface.gradient.weight_sum[srow][d] * prescribed[k];
+        }
+      }
+    }
+    if (!m_.contact.row.empty() && m_.contact.row[iu] >= 0) {
+      contact_velocity_gradient<Dim>(m_.contact, m_.contact.row[iu], sp_v, grad_v);
+    }
+    const int mat = nodes.material[iu];
+    double dv[Dim], dsig[NS];
+    momentum_rate<Dim>(grad_s, 1.0 / nodes.density[iu], dv);
+    // The moduli at the node's stress at t^n when they depend on it (method-notes eq. (1.8.8)).
+    m_.materials.elastic[static_cast<std::size_t>(mat)](grad_v, node_s[i], dsig);
+    double* v = node_v[i];
+    double* s = node_s[i];
+    if constexpr (Velocity::kSimple) {
+      // The simple scheme (method-notes §2.3): from the stress points' velocity, half a step.
+      for (int d = 0; d < Dim; ++d) v[d] = damped_velocity(v_half[d], dv[d] + b[d], cd, 0.5 * dt);
+    } else {
+      for (int d = 0; d < Dim; ++d) v[d] = damped_velocity(v[d], dv[d] + b[d], cd, dt);
+    }
+    if constexpr (Motion::kMoving) {
+      // V2: the Jaumann rotation over the step with the spin of v^{n+1/2}; the density by
+      // continuity; the position moved with the displacement (x - X = u).
+      jaumann_rotate<Dim>(grad_v, dt, s);
+      double tr = 0.0;
+      for (int k = 0; k < Dim; ++k) tr += grad_v[k][k];
+      const double mass = nodes.volume[iu] * nodes.density[iu];
+      nodes.density[iu] /= 1.0 + dt * tr;
+      nodes.volume[iu] = mass / nodes.density[iu];
+      for (int d = 0; d < Dim; ++d) nodes.position[iu][d] += dt * v_half[d];
+    }
+    if (sources) {
+      double* start = src.sigma_start(i);
+      double* rate = src.flux_rate(i);
+      for (int k = 0; k < NS; ++k) {
+        start[k] = s[k];
+        rate[k] = dsig[k];
+      }
+    }
+    for (int k = 0; k < NS; ++k) s[k] += dt * dsig[k];
+    // Displacement by the midpoint rule (method-notes §0.3 item 8).
+    for (int d = 0; d < Dim; ++d) node_u(i, d) += dt * v_half[d];
+  };
+  if constexpr (Motion::kMoving) {
+    if (moving_ != nullptr && moving_->on_the_fly) {
+      // V2, operators on the fly (method-notes §5.2): each node's row evaluated from its
+      // candidates at the stress points' positions and volumes of t^n, kept by step 1.
+      const MovingOperators<Dim>& mo = *moving_;
+      const Relation<Dim>& candidates = *mo.stress_points_near_nodes;
+      const Index nblocks = (nodes.size() + kOnTheFlyBlock - 1) / kOnTheFlyBlock;
+      std::atomic<Index> degenerate{0};
+      std::atomic<std::size_t> pairs{0};
+      exec::particle_for(
+          m_.policy, nblocks,
+          [&](Index blk) {
+            static thread_local CorrectedRow<Dim> row;
+            Index block_degenerate = 0;
+            std::size_t block_pairs = 0;
+            const Index end = std::min(nodes.size(), (blk + 1) * kOnTheFlyBlock);
+            for (Index i = blk * kOnTheFlyBlock; i < end; ++i) {
+              if (!row.evaluate(candidates.row(i), nodes.position[static_cast<std::size_t>(i)],
+                                mo.stress_point_position.data(), mo.stress_point_volume.data(), m_.kernel, mo.r2)) {
+                ++block_degenerate;
+              }
+              block_pairs += row.size();
+              double out_v[Dim + 1][Dim], out_s[Dim + 1][NS];
+              row.template apply<Dim>(sp_v.data(), out_v);
+              row.template apply<NS>(sp_s.data(), out_s);
+              double v_half[Dim], grad_v[Dim][Dim], unused[NS], grad_s[Dim][NS];
+              split_value_gradient<Dim, Dim>(out_v, v_half, grad_v);
+              split_value_gradient<Dim, NS>(out_s, unused, grad_s);
+              update(i, grad_v, grad_s, v_half);
+            }
+            if (block_degenerate > 0) degenerate.fetch_add(block_degenerate, std::memory_order_relaxed);
+            pairs.fetch_add(block_pairs, std::memory_order_relaxed);
+          },
+          exec::Schedule::even, nodes.size());
+      m_.to_nodes.degenerate_rows = degenerate.load();
+      m_.to_nodes.pair_count = pairs.load();
+      moving_->note_degenerate(m_.degenerate_operator_rows(), c.t);
+      if (sources) src.integrate(dt, m_.node_sources, node_s, m_.nodes.view(m_.fields.history));
+      return;
+    }
+  }
   exec::particle_for(
       m_.policy, op.runs(),
       [&](Index r) {
@@ -313,101 +521,13 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
           for (int s = 0; s < NS; ++s) {
             for (int d = 0; d < Dim; ++d) grad_s[d][s] = acc_s[1 + d][ss + static_cast<std::size_t>(s)];
           }
-          const auto iu = static_cast<std::size_t>(i);
-          if (volumetric_rate_ != nullptr) {
-            // The stress points' divergence by the corrected gradient, before fix (a) replaces a
-            // prescribed component's gradient below (V3's storage equation, eq. (2.4.20)).
-            double tr = 0.0;
-            for (int k = 0; k < Dim; ++k) tr += grad_v[k][k];
-            volumetric_rate_[iu] = tr;
-          }
           // The material velocity at t^{n+1/2} for the displacement: the stress points' velocity,
           // interpolated back. Not the nodal v, which in a steady state keeps an O(dt) component
           // the stress points never see (it balances the filter against the residual nodal
           // force: method-notes §0.3 item 8), and would make u drift.
           double v_half[Dim];
           for (int d = 0; d < Dim; ++d) v_half[d] = acc_v[0][sv + static_cast<std::size_t>(d)];
-          for (Index q = constraints.begin(i); q < constraints.end(i); ++q) {
-            const NodalConstraint& con = constraints[q];
-            if (con.component < Dim) v_half[con.component] = m_.constraint_value(i, con, t_half);
-          }
-          const Index drow = constraints.constrained_row(i);
-          if (drow >= 0) {
-            // method-notes §0.3 fix (a): a prescribed component enters its own gradient through
-            // the difference form with fhat = the prescribed value at t^{n+1/2}.
-            const auto dr = static_cast<std::size_t>(drow);
-            for (Index q = constraints.begin(i); q < constraints.end(i); ++q) {
-              const NodalConstraint& con = constraints[q];
-              const double fhat = m_.constraint_value(i, con, t_half);
-              const bool is_velocity = con.component < Dim;
-              const int comp = is_velocity ? con.component : con.component - Dim;
-              double g[Dim] = {};
-              for (Index k = diff.row_start[dr]; k < diff.row_start[dr + 1]; ++k) {
-                const Index e = diff.source[static_cast<std::size_t>(k)];
-                const double f = is_velocity ? sp_v(e, comp) : sp_s(e, comp);
-                for (int d = 0; d < Dim; ++d) g[d] += diff.weight[static_cast<std::size_t>(k)][d] * f;
-              }
-              for (int d = 0; d < Dim; ++d) {
-                const double value = g[d] - diff.weight_sum[dr][d] * fhat;
-                if (is_velocity) {
-                  grad_v[d][comp] = value;
-                } else {
-                  grad_s[d][comp] = value;
-                }
-              }
-            }
-          }
-          if (!m_.surface.row.empty() && m_.surface.row[iu] >= 0) {
-            surface_stress_gradient<Dim>(m_.surface, m_.surface.row[iu], sp_s, grad_s);
-            if (!m_.surface.traction.empty()) {
-              // A prescribed traction (polygon edges, method-notes §3.9): the difference form
-              // with fhat = the stress it prescribes, as fix (a) of §0.3 item 1.
-              const auto srow = static_cast<std::size_t>(m_.surface.row[iu]);
-              double prescribed[NS] = {};
-              m_.add_surface_traction(srow, t_half, prescribed);
-              for (int d = 0; d < Dim; ++d) {
-                for (int k = 0; k < NS; ++k) grad_s[d][k] -= m_.surface.gradient.weight_sum[srow][d] * prescribed[k];
-              }
-            }
-          }
-          if (!m_.contact.row.empty() && m_.contact.row[iu] >= 0) {
-            contact_velocity_gradient<Dim>(m_.contact, m_.contact.row[iu], sp_v, grad_v);
-          }
-          const int mat = nodes.material[iu];
-          double dv[Dim], dsig[NS];
-          momentum_rate<Dim>(grad_s, 1.0 / nodes.density[iu], dv);
-          // The moduli at the node's stress at t^n when they depend on it (method-notes eq. (1.8.8)).
-          m_.materials.elastic[static_cast<std::size_t>(mat)](grad_v, node_s[i], dsig);
-          double* v = node_v[i];
-          double* s = node_s[i];
-          if constexpr (Velocity::kSimple) {
-            // The simple scheme (method-notes §2.3): from the stress points' velocity, half a step.
-            for (int d = 0; d < Dim; ++d) v[d] = damped_velocity(v_half[d], dv[d] + b[d], cd, 0.5 * dt);
-          } else {
-            for (int d = 0; d < Dim; ++d) v[d] = damped_velocity(v[d], dv[d] + b[d], cd, dt);
-          }
-          if constexpr (Motion::kMoving) {
-            // V2: the Jaumann rotation over the step with the spin of v^{n+1/2}; the density by
-            // continuity; the position moved with the displacement (x - X = u).
-            jaumann_rotate<Dim>(grad_v, dt, s);
-            double tr = 0.0;
-            for (int k = 0; k < Dim; ++k) tr += grad_v[k][k];
-            const double mass = nodes.volume[iu] * nodes.density[iu];
-            nodes.density[iu] /= 1.0 + dt * tr;
-            nodes.volume[iu] = mass / nodes.density[iu];
-            for (int d = 0; d < Dim; ++d) nodes.position[iu][d] += dt * v_half[d];
-          }
-          if (sources) {
-            double* start = src.sigma_start(i);
-            double* rate = src.flux_rate(i);
-            for (int k = 0; k < NS; ++k) {
-              start[k] = s[k];
-              rate[k] = dsig[k];
-            }
-          }
-          for (int k = 0; k < NS; ++k) s[k] += dt * dsig[k];
-          // Displacement by the midpoint rule (method-notes §0.3 item 8).
-          for (int d = 0; d < Dim; ++d) node_u(i, d) += dt * v_half[d];
+          update(i, grad_v, grad_s, v_half);
         }
       },
       exec::Schedule::even, nodes.size());

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "schemes/motion.hpp"
+#include "schemes/moving_operators.hpp"
 #include "schemes/stage.hpp"
 #include "schemes/staggered_model.hpp"
 
@@ -78,11 +79,15 @@ class StressPointHalfStep final : public Stage {
                       PressureTerm pressure = {});
   std::string_view name() const override { return "stress_points_half_step"; }
   void run(const StepContext& context) override;
+  /// Moving particles: evaluate the operator's rows from `moving`'s candidates in the step
+  /// instead of reading the model's stored operator when moving->on_the_fly (method-notes §5.2).
+  void set_moving_operators(MovingOperators<Dim>* moving) { moving_ = moving; }
 
  private:
   StaggeredModel<Dim>& m_;
   std::shared_ptr<ViscoplasticSources<Dim>> sources_;
   PressureTerm pressure_;
+  MovingOperators<Dim>* moving_ = nullptr;
 };
 
 /// Step 2: gradient of the stress points' state at the nodes, full step of the flux and the
@@ -104,11 +109,15 @@ class NodeFullStep final : public Stage {
   /// integrates (before fix (a) at prescribed components), for V3's consistent storage equation
   /// (method-notes eq. (2.4.20)). Null: not recorded.
   void record_volumetric_rate(double* rate) { volumetric_rate_ = rate; }
+  /// Moving particles: as StressPointHalfStep::set_moving_operators, on the stress points'
+  /// geometry of t^n that step 1 kept.
+  void set_moving_operators(MovingOperators<Dim>* moving) { moving_ = moving; }
 
  private:
   StaggeredModel<Dim>& m_;
   std::shared_ptr<ViscoplasticSources<Dim>> sources_;
   double* volumetric_rate_ = nullptr;
+  MovingOperators<Dim>* moving_ = nullptr;
 };
 
 /// The prescribed components at t^{n+1} (method-notes §4.1).

@@ -58,6 +58,7 @@ std::unique_ptr<Scheme> make_v2_scheme(StaggeredModel<Dim>& model) {
     reseed = &scheme->add(std::make_unique<ReseedStressPoints<Dim>>(model, std::move(excluded)));
   }
   auto& rebuilt = scheme->add(std::move(rebuild));
+  if (reseed != nullptr) reseed->set_moving_operators(&rebuilt.moving_operators());
   if constexpr (Dim == 2) {
     if (contact) scheme->add(std::make_unique<ContactSelect>(model, rebuilt, contact));
   }
@@ -72,12 +73,18 @@ std::unique_ptr<Scheme> make_v2_scheme(StaggeredModel<Dim>& model) {
     surface = &scheme->add(std::move(detect));
     if constexpr (Dim == 2) surface->set_contact(contact.get());
   }
-  scheme->add(std::make_unique<StressPointHalfStep<Dim, NoPressureGradient, MovingParticles>>(model, sources));
+  // The operators applied on the fly or stored (solver.operators): the steps read the
+  // candidates and the degenerate-row record from the rebuild stage either way.
+  MovingOperators<Dim>* moving = &rebuilt.moving_operators();
+  scheme->add(std::make_unique<StressPointHalfStep<Dim, NoPressureGradient, MovingParticles>>(model, sources))
+      .set_moving_operators(moving);
   if (model.setup.simple_velocity) {
-    scheme->add(std::make_unique<NodeFullStep<Dim, MovingParticles, SimpleVelocity>>(model, sources));
+    scheme->add(std::make_unique<NodeFullStep<Dim, MovingParticles, SimpleVelocity>>(model, sources))
+        .set_moving_operators(moving);
     scheme->add(std::make_unique<ApplyConstraints<Dim>>(model));
   } else {
-    scheme->add(std::make_unique<NodeFullStep<Dim, MovingParticles, TaylorGalerkinVelocity>>(model, sources));
+    scheme->add(std::make_unique<NodeFullStep<Dim, MovingParticles, TaylorGalerkinVelocity>>(model, sources))
+        .set_moving_operators(moving);
     scheme->add(std::make_unique<ApplyConstraints<Dim>>(model));
     if (model.setup.filter) {
       scheme->add(std::make_unique<VelocityFilter<Dim>>(model, model.setup.filter_strength));

@@ -28,7 +28,13 @@ RebuildOperators<Dim>::RebuildOperators(StaggeredModel<Dim>& model, ReorderActio
     : m_(model),
       reorder_(std::move(reorder)),
       skin_(kSkinOverH * model.kernel.h()),
-      constrained_positions_(model.constraints.constrained().size()) {}
+      constrained_positions_(model.constraints.constrained().size()) {
+  moving_.on_the_fly = model.setup.operators_on_the_fly;
+  moving_.nodes_near_stress_points = &to_stress_points_;
+  moving_.stress_points_near_nodes = &to_nodes_;
+  const double r = operator_relation_options(model.kernel).radius;
+  moving_.r2 = r * r;
+}
 
 template <int Dim>
 bool RebuildOperators<Dim>::morton_orders() {
@@ -160,22 +166,28 @@ void RebuildOperators<Dim>::run(const StepContext& c) {
     sort_seconds_ += since(tg);
   }
   const auto t0 = Clock::now();
-  rebuild_corrected_operator<Dim>(to_stress_points_, m_.stress_points.position, m_.nodes, m_.kernel,
-                                  m_.to_stress_points, m_.policy);
-  rebuild_corrected_operator<Dim>(to_nodes_, m_.nodes.position, m_.stress_points, m_.kernel, m_.to_nodes, m_.policy);
+  if (moving_.on_the_fly) {
+    // The steps evaluate the rows (and count the degenerate ones); the operators the model
+    // built at the start (for the initial state) are not needed again.
+    if (m_.to_stress_points.rows() > 0) m_.to_stress_points = {};
+    if (m_.to_nodes.rows() > 0) m_.to_nodes = {};
+  } else {
+    rebuild_corrected_operator<Dim>(to_stress_points_, m_.stress_points.position, m_.nodes, m_.kernel,
+                                    m_.to_stress_points, m_.policy);
+    rebuild_corrected_operator<Dim>(to_nodes_, m_.nodes.position, m_.stress_points, m_.kernel, m_.to_nodes,
+                                    m_.policy);
+  }
   build_difference_gradient_into<Dim>(constrained_, constrained_positions_, m_.stress_points, m_.kernel,
                                       m_.constrained_gradient);
   ++operator_builds_;
   operator_seconds_ += since(t0);
-  const Index degenerate = m_.degenerate_operator_rows();
-  if (degenerate > 0 && degenerate_first_time_ < 0.0) degenerate_first_time_ = c.t;
-  degenerate_max_ = std::max(degenerate_max_, degenerate);
+  if (!moving_.on_the_fly) moving_.note_degenerate(m_.degenerate_operator_rows(), c.t);
 }
 
 template <int Dim>
 void RebuildOperators<Dim>::save(io::StateArchive& a, const std::string& prefix) const {
-  a.put_integer(prefix + "degenerate_max", degenerate_max_);
-  a.put(prefix + "degenerate_first_time", degenerate_first_time_);
+  a.put_integer(prefix + "degenerate_max", moving_.degenerate_max);
+  a.put(prefix + "degenerate_first_time", moving_.degenerate_first_time);
   // The Verlet reference: when the next search is due, and with it the next sort.
   auto flat = [](const std::vector<Vec<Dim>>& x) {
     std::vector<double> out;
@@ -196,8 +208,8 @@ void RebuildOperators<Dim>::save(io::StateArchive& a, const std::string& prefix)
 
 template <int Dim>
 void RebuildOperators<Dim>::load(const io::StateArchive& a, const std::string& prefix) {
-  degenerate_max_ = static_cast<Index>(a.integer(prefix + "degenerate_max"));
-  degenerate_first_time_ = a.number(prefix + "degenerate_first_time");
+  moving_.degenerate_max = static_cast<Index>(a.integer(prefix + "degenerate_max"));
+  moving_.degenerate_first_time = a.number(prefix + "degenerate_first_time");
   if (!a.has(prefix + "verlet_nodes")) return;  // an older checkpoint: search (and sort) afresh
   if (a.has(prefix + "storage_gap")) {
     gap_ = a.number(prefix + "storage_gap");

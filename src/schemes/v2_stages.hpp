@@ -12,6 +12,7 @@
 #include "neighbours/relation.hpp"
 #include "operators/free_surface.hpp"
 #include "schemes/body_output.hpp"
+#include "schemes/moving_operators.hpp"
 #include "schemes/stage.hpp"
 #include "schemes/staggered_model.hpp"
 
@@ -20,8 +21,10 @@ namespace rktsph {
 /// The corrected operators and the difference gradient recomputed from the particles' current
 /// positions every step (never frozen), over Verlet lists: relations built with a skin around
 /// the support, rebuilt only when some particle has moved half the skin since the last build
-/// (so that no pair within the support can be missing). Operators are plain CSR: moved
-/// particles no longer share row geometries. With a `reorder` action (solver.sort = "auto" or
+/// (so that no pair within the support can be missing). On the fly (solver.operators, the
+/// default) the steps evaluate the operators' rows from these lists themselves
+/// (MovingOperators); stored, the weights are rebuilt here as plain CSR (moved particles no
+/// longer share row geometries). With a `reorder` action (solver.sort = "auto" or
 /// "always"), both sets are sorted into the Morton order of their cells just before a search
 /// (every one, or once the storage has become disordered), and the action moves the model's
 /// and the stages' per-particle tables with them.
@@ -34,6 +37,7 @@ class RebuildOperators final : public Stage {
   void run(const StepContext& context) override;
   std::size_t scratch_bytes() const override {
     return to_stress_points_.bytes() + to_nodes_.bytes() + constrained_.bytes() + node_neighbours_.bytes() +
+           moving_.bytes() +
            sort_keys_.capacity() * sizeof(std::uint64_t) +
            (reordering_.nodes.capacity() + reordering_.stress_points.capacity()) * sizeof(Index);
   }
@@ -54,6 +58,9 @@ class RebuildOperators final : public Stage {
   const Relation<Dim>& node_neighbours() const { return node_neighbours_; }
   /// The stress points near each node (Verlet), for the surface nodes' difference gradient.
   const Relation<Dim>& stress_points_of_nodes() const { return to_nodes_; }
+  /// The candidates of the steps' operator rows and the degenerate-row record (both storages).
+  MovingOperators<Dim>& moving_operators() { return moving_; }
+  const MovingOperators<Dim>& moving_operators() const { return moving_; }
   /// The degenerate-row record and the Verlet reference survive a resume; the lists are
   /// searched afresh after one, on the checkpoint's order.
   void save(io::StateArchive& archive, const std::string& prefix) const override;
@@ -67,8 +74,9 @@ class RebuildOperators final : public Stage {
             {"operator_builds", static_cast<double>(operator_builds_)},
             {"operator_build_seconds", operator_seconds_},
             {"verlet_skin", skin_},
-            {"degenerate_rows_max", static_cast<double>(degenerate_max_)},
-            {"degenerate_rows_first_time", degenerate_first_time_}};
+            {"degenerate_rows_max", static_cast<double>(moving_.degenerate_max)},
+            {"degenerate_rows_first_time", moving_.degenerate_first_time},
+            {"operators_on_the_fly", moving_.on_the_fly ? 1.0 : 0.0}};
   }
 
  private:
@@ -102,10 +110,7 @@ class RebuildOperators final : public Stage {
   std::int64_t stress_point_replacements_at_build_ = 0;  // a re-seeded set needs a new search
   long relation_builds_ = 0, operator_builds_ = 0;
   double relation_seconds_ = 0.0, operator_seconds_ = 0.0;
-  // Rows of the two operators with too few neighbours (plain SPH sums there): the most at any
-  // step, and the time they first appeared (-1: never). A body tearing apart shows here.
-  Index degenerate_max_ = 0;
-  double degenerate_first_time_ = -1.0;
+  MovingOperators<Dim> moving_;
 };
 
 /// The free surface of the nodes detected on their positions at t^n (method-notes §3.6), after

@@ -1,0 +1,227 @@
+#pragma once
+// One row of the corrected operator (method-notes §3.2, eq. (3.2.3)) evaluated from the current
+// positions: the target's candidates inside the support are gathered by a branch-free
+// compaction, then the kernel basis w_b = V_b [W_ab; h grad_a W_ab] and the moment matrix M_a
+// in loops over the pairs that the compiler vectorises (`omp simd`: the square root, the
+// division and the kernel's piece 8 pairs at a time, no mispredicted branch).
+//
+// A row is used in two ways (method-notes §5.2, "Operators on the fly"):
+//   weights()   the pair weights c_ab = M_a^{-1} w_b, written into a stored operator (the
+//               rebuild of operators/corrected_operator.cpp);
+//   apply()     the value and gradient of a field directly, M_a^{-1} sum_b w_b f_b: the same
+//               sums in another order (equal to round-off), with nothing stored per pair. The
+//               V2 step applies its operators this way, so that a step neither writes nor
+//               reads back the weights (28 bytes a pair).
+// A degenerate row (too few sources: |det M_a| <= 1e-8) falls back to Shepard interpolation
+// and the plain kernel gradient, in both uses.
+#include <array>
+#include <cmath>
+#include <cstddef>
+#include <span>
+#include <vector>
+
+#include <Eigen/Dense>
+
+#include "core/kernel.hpp"
+#include "core/types.hpp"
+
+namespace rktsph {
+
+template <int Dim>
+class CorrectedRow {
+ public:
+  static constexpr int N = Dim + 1;
+
+  /// The candidates of target xa (any order) with |x_a - x_b|^2 < r2, kept in candidate order,
+  /// their basis and the moment matrix. `position` and `volume` are the sources' (indexed by
+  /// the candidates). Returns false for a degenerate row. Allocates only while the work space
+  /// grows.
+  bool evaluate(std::span<const Index> candidates, const Vec<Dim>& xa, const Vec<Dim>* position, const double* volume,
+                const CubicSplineKernel<Dim>& kernel, double r2) {
+    gather(candidates, xa, position, volume, r2);
+    return moments(kernel);
+  }
+
+  std::size_t size() const { return n_; }
+  bool degenerate() const { return !ok_; }
+  /// The sources of the row, in candidate order.
+  const Index* sources() const { return source_.data(); }
+
+  /// The pair weights: interp[k] and grad[k] for the row's k = 0..size()-1.
+  void weights(double* interp, std::array<double, Dim>* grad) const {
+    const double* w[N];
+    for (int i = 0; i < N; ++i) w[i] = basis_[i].data();
+    if (ok_) {
+#pragma omp simd
+      for (std::size_t k = 0; k < n_; ++k) {
+        double c[N];
+        for (int i = 0; i < N; ++i) {
+          c[i] = 0.0;
+          for (int j = 0; j < N; ++j) c[i] += minv_[i][j] * w[j][k];
+        }
+        interp[k] = c[0];
+        for (int d = 0; d < Dim; ++d) grad[k][static_cast<std::size_t>(d)] = c[d + 1] * inv_h_;
+      }
+    } else {
+      for (std::size_t k = 0; k < n_; ++k) {
+        interp[k] = shepard_ > 0.0 ? w[0][k] / shepard_ : 0.0;
+        for (int d = 0; d < Dim; ++d) grad[k][static_cast<std::size_t>(d)] = w[1 + d][k] * inv_h_;
+      }
+    }
+  }
+
+  /// The corrected value (out[0]) and gradient (out[1 + d], d/dx_d) at the target of the field
+  /// of NF values per source (`field` + NF b holds source b's), eq. (3.2.3) applied as
+  /// M_a^{-1} sum_b w_b f_b.
+  template <int NF>
+  void apply(const double* field, double (&out)[N][NF]) const {
+    double s[N][NF] = {};
+    for (std::size_t k = 0; k < n_; ++k) {
+      const double* f = field + static_cast<std::size_t>(source_[k]) * NF;
+      for (int i = 0; i < N; ++i) {
+        const double wk = basis_[i][k];
+        for (int j = 0; j < NF; ++j) s[i][j] += wk * f[j];
+      }
+    }
+    finish<NF>(s, out);
+  }
+
+  /// The corrected value alone of a field of nf values per source (the history variables).
+  void interpolate(const double* field, int nf, double* out) const {
+    for (int j = 0; j < nf; ++j) out[j] = 0.0;
+    if (!ok_) {
+      if (shepard_ <= 0.0) return;
+      for (std::size_t k = 0; k < n_; ++k) {
+        const double c = basis_[0][k] / shepard_;
+        const double* f = field + static_cast<std::size_t>(source_[k]) * static_cast<std::size_t>(nf);
+        for (int j = 0; j < nf; ++j) out[j] += c * f[j];
+      }
+      return;
+    }
+    // The value's row of M^{-1} folded into one weight per pair: M^{-1}_0j w_j,b.
+    for (std::size_t k = 0; k < n_; ++k) {
+      double c = 0.0;
+      for (int i = 0; i < N; ++i) c += minv_[0][i] * basis_[i][k];
+      const double* f = field + static_cast<std::size_t>(source_[k]) * static_cast<std::size_t>(nf);
+      for (int j = 0; j < nf; ++j) out[j] += c * f[j];
+    }
+  }
+
+ private:
+  void reserve(std::size_t m) {
+    if (source_.size() >= m) return;
+    source_.resize(m);
+    for (auto& v : x_ab_) v.resize(m);
+    d2_.resize(m);
+    volume_.resize(m);
+    for (auto& v : basis_) v.resize(m);
+  }
+
+  void gather(std::span<const Index> candidates, const Vec<Dim>& xa, const Vec<Dim>* position, const double* volume,
+              double r2) {
+    reserve(candidates.size());
+    std::size_t count = 0;
+    for (const Index b : candidates) {
+      const auto bu = static_cast<std::size_t>(b);
+      const Vec<Dim> x = xa - position[bu];
+      const double s = x.squaredNorm();
+      source_[count] = b;
+      for (int d = 0; d < Dim; ++d) x_ab_[d][count] = x[d];
+      d2_[count] = s;
+      volume_[count] = volume[bu];
+      count += s < r2 ? 1 : 0;
+    }
+    n_ = count;
+  }
+
+  // The basis V_b [W_ab; h grad_a W_ab] (grad_a W_ab = W'/r x_ab) and
+  // M = sum_b w_b (x) [1, (x_b - x_a)/h] (O(1) in these units); M^{-1} unless degenerate.
+  bool moments(const CubicSplineKernel<Dim>& kernel) {
+    using MatN = Eigen::Matrix<double, N, N>;
+    inv_h_ = kernel.inv_h();
+    const double inv_h = inv_h_, alpha = kernel.alpha();
+    const std::size_t n = n_;
+    const double* d2 = d2_.data();
+    const double* V = volume_.data();
+    const double* x[Dim];
+    double* w[N];
+    for (int d = 0; d < Dim; ++d) x[d] = x_ab_[d].data();
+    for (int i = 0; i < N; ++i) w[i] = basis_[i].data();
+#pragma omp simd
+    for (std::size_t k = 0; k < n; ++k) {
+      double W, g;
+      CubicSplineKernel<Dim>::value_and_scaled_derivative(std::sqrt(d2[k]), inv_h, alpha, W, g);
+      w[0][k] = V[k] * W;
+      for (int d = 0; d < Dim; ++d) w[1 + d][k] = V[k] * g * x[d][k];
+    }
+    // In 2D the nine sums in one vectorised pass (nine vector accumulators); otherwise one
+    // entry at a time, each a vectorised dot product.
+    MatN M;
+    if constexpr (Dim == 2) {
+      const double *w0 = w[0], *w1 = w[1], *w2 = w[2], *x0 = x[0], *x1 = x[1];
+      double s00 = 0, s01 = 0, s02 = 0, s10 = 0, s11 = 0, s12 = 0, s20 = 0, s21 = 0, s22 = 0;
+#pragma omp simd reduction(+ : s00, s01, s02, s10, s11, s12, s20, s21, s22)
+      for (std::size_t k = 0; k < n; ++k) {
+        s00 += w0[k], s01 += w0[k] * x0[k], s02 += w0[k] * x1[k];
+        s10 += w1[k], s11 += w1[k] * x0[k], s12 += w1[k] * x1[k];
+        s20 += w2[k], s21 += w2[k] * x0[k], s22 += w2[k] * x1[k];
+      }
+      M << s00, -s01 * inv_h, -s02 * inv_h, s10, -s11 * inv_h, -s12 * inv_h, s20, -s21 * inv_h, -s22 * inv_h;
+    } else {
+      for (int i = 0; i < N; ++i) {
+        const double* wi = w[i];
+        double s0 = 0.0;
+#pragma omp simd reduction(+ : s0)
+        for (std::size_t k = 0; k < n; ++k) s0 += wi[k];
+        M(i, 0) = s0;
+        for (int d = 0; d < Dim; ++d) {
+          const double* xd = x[d];
+          double s = 0.0;
+#pragma omp simd reduction(+ : s)
+          for (std::size_t k = 0; k < n; ++k) s += wi[k] * xd[k];
+          M(i, 1 + d) = -s * inv_h;
+        }
+      }
+    }
+    shepard_ = M(0, 0);
+    ok_ = n > 0 && std::abs(M.determinant()) > 1e-8;
+    if (ok_) {
+      const MatN Minv = M.inverse();
+      for (int i = 0; i < N; ++i)
+        for (int j = 0; j < N; ++j) minv_[i][j] = Minv(i, j);
+    }
+    return ok_;
+  }
+
+  // out = M^{-1} s with the gradient rows back in 1/m; Shepard and the plain gradient when
+  // degenerate.
+  template <int NF>
+  void finish(const double (&s)[N][NF], double (&out)[N][NF]) const {
+    if (ok_) {
+      for (int i = 0; i < N; ++i) {
+        const double scale = i == 0 ? 1.0 : inv_h_;
+        for (int j = 0; j < NF; ++j) {
+          double v = 0.0;
+          for (int q = 0; q < N; ++q) v += minv_[i][q] * s[q][j];
+          out[i][j] = v * scale;
+        }
+      }
+      return;
+    }
+    for (int j = 0; j < NF; ++j) out[0][j] = shepard_ > 0.0 ? s[0][j] / shepard_ : 0.0;
+    for (int i = 1; i < N; ++i)
+      for (int j = 0; j < NF; ++j) out[i][j] = s[i][j] * inv_h_;
+  }
+
+  std::vector<Index> source_;
+  std::vector<double> x_ab_[Dim];  // x_a - x_b
+  std::vector<double> d2_;         // |x_a - x_b|^2
+  std::vector<double> volume_;
+  std::vector<double> basis_[N];  // V_b [W_ab; h grad_a W_ab]
+  std::size_t n_ = 0;
+  double minv_[N][N] = {};
+  double shepard_ = 0.0, inv_h_ = 0.0;
+  bool ok_ = false;
+};
+
+}  // namespace rktsph
