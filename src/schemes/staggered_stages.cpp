@@ -206,8 +206,7 @@ void StressPointHalfStep<Dim, PressureTerm, Motion>::run(const StepContext& c) {
               mo.stress_point_position[eu] = sp.position[eu];
               mo.stress_point_volume[eu] = sp.volume[eu];
               double out_v[Dim + 1][Dim], out_s[Dim + 1][NS];
-              row.template apply<Dim>(node_v.data(), out_v);
-              row.template apply<NS>(node_s.data(), out_s);
+              row.template apply<Dim, NS>(node_v.data(), node_s.data(), out_v, out_s);
               double bar_v[Dim], bar_s[NS], grad_v[Dim][Dim], grad_s[Dim][NS];
               split_value_gradient<Dim, Dim>(out_v, bar_v, grad_v);
               split_value_gradient<Dim, NS>(out_s, bar_s, grad_s);
@@ -483,8 +482,7 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
               }
               block_pairs += row.size();
               double out_v[Dim + 1][Dim], out_s[Dim + 1][NS];
-              row.template apply<Dim>(sp_v.data(), out_v);
-              row.template apply<NS>(sp_s.data(), out_s);
+              row.template apply<Dim, NS>(sp_v.data(), sp_s.data(), out_v, out_s);
               double v_half[Dim], grad_v[Dim][Dim], unused[NS], grad_s[Dim][NS];
               split_value_gradient<Dim, Dim>(out_v, v_half, grad_v);
               split_value_gradient<Dim, NS>(out_s, unused, grad_s);
