@@ -43,9 +43,14 @@ inline void sin_cos(double theta, double& sn, double& c) {
     c = std::cos(theta);
     return;
   }
+  // Horner in theta^2 with the coefficients as constants (divisions here cost a third of step 1).
   const double t2 = theta * theta;
-  sn = theta * (1.0 - t2 / 6.0 * (1.0 - t2 / 20.0 * (1.0 - t2 / 42.0 * (1.0 - t2 / 72.0 * (1.0 - t2 / 110.0)))));
-  c = 1.0 - t2 / 2.0 * (1.0 - t2 / 12.0 * (1.0 - t2 / 30.0 * (1.0 - t2 / 56.0 * (1.0 - t2 / 90.0 * (1.0 - t2 / 132.0)))));
+  constexpr double s3 = -1.0 / 6.0, s5 = 1.0 / 120.0, s7 = -1.0 / 5040.0, s9 = 1.0 / 362880.0,
+                   s11 = -1.0 / 39916800.0;
+  constexpr double c2 = -0.5, c4 = 1.0 / 24.0, c6 = -1.0 / 720.0, c8 = 1.0 / 40320.0, c10 = -1.0 / 3628800.0,
+                   c12 = 1.0 / 479001600.0;
+  sn = theta + theta * t2 * (s3 + t2 * (s5 + t2 * (s7 + t2 * (s9 + t2 * s11))));
+  c = 1.0 + t2 * (c2 + t2 * (c4 + t2 * (c6 + t2 * (c8 + t2 * (c10 + t2 * c12)))));
 }
 
 /// The Jaumann term d sigma/dt = W sigma - sigma W over tau with the spin W = skew(grad v)
