@@ -118,10 +118,12 @@ void detect_free_surface(const ParticleSet<Dim>& set, const Relation<Dim>& relat
     Vec<Dim> g;
     pairs.moments(inv_h, alpha, B, g);
     lambda[iu] = smallest_eigenvalue<Dim>(B);
+    // The rest concerns candidates only: an interior node (most of a body) stops here.
+    if (lambda[iu] > options.interior_above) return;
+    if (!excluded.empty() && excluded[iu] != 0) return;
     Vec<Dim> nu = std::abs(B.determinant()) > 1e-12 ? Vec<Dim>(-(B.inverse() * g)) : Vec<Dim>(-g);
     const double len = nu.norm();
     const Vec<Dim> normal = len > 0.0 ? Vec<Dim>(nu / len) : Vec<Dim>::Zero();
-    if (!excluded.empty() && excluded[iu] != 0) return;
     bool surface = false;
     if (lambda[iu] <= options.surface_below) {
       surface = true;
