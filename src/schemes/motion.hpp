@@ -45,8 +45,7 @@ inline void sin_cos(double theta, double& sn, double& c) {
   }
   // Horner in theta^2 with the coefficients as constants (divisions here cost a third of step 1).
   const double t2 = theta * theta;
-  constexpr double s3 = -1.0 / 6.0, s5 = 1.0 / 120.0, s7 = -1.0 / 5040.0, s9 = 1.0 / 362880.0,
-                   s11 = -1.0 / 39916800.0;
+  constexpr double s3 = -1.0 / 6.0, s5 = 1.0 / 120.0, s7 = -1.0 / 5040.0, s9 = 1.0 / 362880.0, s11 = -1.0 / 39916800.0;
   constexpr double c2 = -0.5, c4 = 1.0 / 24.0, c6 = -1.0 / 720.0, c8 = 1.0 / 40320.0, c10 = -1.0 / 3628800.0,
                    c12 = 1.0 / 479001600.0;
   sn = theta + theta * t2 * (s3 + t2 * (s5 + t2 * (s7 + t2 * (s9 + t2 * s11))));

@@ -29,6 +29,37 @@ inline void split_value_gradient(const double (&out)[Dim + 1][NF], double (&valu
   }
 }
 
+// Rows [0, rows) of an operator evaluated on the fly, in blocks of kOnTheFlyBlock shared out to
+// the threads: per_row(row, a) evaluates row a into the thread's CorrectedRow, uses it and
+// returns false for a degenerate row. The degenerate rows and the pairs are counted (integer
+// sums: the same whatever the threads).
+struct RowCounts {
+  Index degenerate = 0;
+  std::size_t pairs = 0;
+};
+template <int Dim, class PerRow>
+RowCounts rows_on_the_fly(const exec::Threads& policy, Index rows, PerRow&& per_row) {
+  const Index nblocks = (rows + kOnTheFlyBlock - 1) / kOnTheFlyBlock;
+  std::atomic<Index> degenerate{0};
+  std::atomic<std::size_t> pairs{0};
+  exec::particle_for(
+      policy, nblocks,
+      [&](Index blk) {
+        static thread_local CorrectedRow<Dim> row;
+        Index block_degenerate = 0;
+        std::size_t block_pairs = 0;
+        const Index end = std::min(rows, (blk + 1) * kOnTheFlyBlock);
+        for (Index a = blk * kOnTheFlyBlock; a < end; ++a) {
+          if (!per_row(row, a)) ++block_degenerate;
+          block_pairs += row.size();
+        }
+        if (block_degenerate > 0) degenerate.fetch_add(block_degenerate, std::memory_order_relaxed);
+        pairs.fetch_add(block_pairs, std::memory_order_relaxed);
+      },
+      exec::Schedule::even, rows);
+  return {degenerate.load(), pairs.load()};
+}
+
 }  // namespace
 
 namespace {
@@ -137,8 +168,8 @@ void StressPointHalfStep<Dim, PressureTerm, Motion>::run(const StepContext& c) {
   const PressureTerm& pressure = pressure_;
   // The update of stress point e from the interpolated nodal state (bar_v, bar_s), its gradient
   // and, in V3, the pressure gradient; history(ks) writes the interpolated history variables.
-  auto update = [&](Index e, const double (&bar_v)[Dim], const double (&grad_v)[Dim][Dim], double (&bar_s)[NS],
-                    const double (&grad_s)[Dim][NS], [[maybe_unused]] const double* grad_p, auto&& history) {
+  auto update = [&](Index e, const double(&bar_v)[Dim], const double(&grad_v)[Dim][Dim], double(&bar_s)[NS],
+                    const double(&grad_s)[Dim][NS], [[maybe_unused]] const double* grad_p, auto&& history) {
     const auto eu = static_cast<std::size_t>(e);
     const int mat = sp.material[eu];
     double dv[Dim], dsig[NS];
@@ -186,39 +217,23 @@ void StressPointHalfStep<Dim, PressureTerm, Motion>::run(const StepContext& c) {
       mo.resize(sp.size());
       const Relation<Dim>& candidates = *mo.nodes_near_stress_points;
       const ParticleSet<Dim>& nodes = m_.nodes;
-      const Index nblocks = (sp.size() + kOnTheFlyBlock - 1) / kOnTheFlyBlock;
-      std::atomic<Index> degenerate{0};
-      std::atomic<std::size_t> pairs{0};
-      exec::particle_for(
-          m_.policy, nblocks,
-          [&](Index blk) {
-            static thread_local CorrectedRow<Dim> row;
-            Index block_degenerate = 0;
-            std::size_t block_pairs = 0;
-            const Index end = std::min(sp.size(), (blk + 1) * kOnTheFlyBlock);
-            for (Index e = blk * kOnTheFlyBlock; e < end; ++e) {
-              const auto eu = static_cast<std::size_t>(e);
-              if (!row.evaluate(candidates.row(e), sp.position[eu], nodes.position.data(), nodes.volume.data(),
-                                m_.kernel, mo.r2)) {
-                ++block_degenerate;
-              }
-              block_pairs += row.size();
-              mo.stress_point_position[eu] = sp.position[eu];
-              mo.stress_point_volume[eu] = sp.volume[eu];
-              double out_v[Dim + 1][Dim], out_s[Dim + 1][NS];
-              row.template apply<Dim, NS>(node_v.data(), node_s.data(), out_v, out_s);
-              double bar_v[Dim], bar_s[NS], grad_v[Dim][Dim], grad_s[Dim][NS];
-              split_value_gradient<Dim, Dim>(out_v, bar_v, grad_v);
-              split_value_gradient<Dim, NS>(out_s, bar_s, grad_s);
-              update(e, bar_v, grad_v, bar_s, grad_s, nullptr,
-                     [&](double* ks) { row.interpolate(node_k.data(), stride, ks); });
-            }
-            if (block_degenerate > 0) degenerate.fetch_add(block_degenerate, std::memory_order_relaxed);
-            pairs.fetch_add(block_pairs, std::memory_order_relaxed);
-          },
-          exec::Schedule::even, sp.size());
-      m_.to_stress_points.degenerate_rows = degenerate.load();
-      m_.to_stress_points.pair_count = pairs.load();
+      const RowCounts counts = rows_on_the_fly<Dim>(m_.policy, sp.size(), [&](CorrectedRow<Dim>& row, Index e) {
+        const auto eu = static_cast<std::size_t>(e);
+        const bool ok = row.evaluate(candidates.row(e), sp.position[eu], nodes.position.data(), nodes.volume.data(),
+                                     m_.kernel, mo.r2);
+        mo.stress_point_position[eu] = sp.position[eu];
+        mo.stress_point_volume[eu] = sp.volume[eu];
+        double out_v[Dim + 1][Dim], out_s[Dim + 1][NS];
+        row.template apply<Dim, NS>(node_v.data(), node_s.data(), out_v, out_s);
+        double bar_v[Dim], bar_s[NS], grad_v[Dim][Dim], grad_s[Dim][NS];
+        split_value_gradient<Dim, Dim>(out_v, bar_v, grad_v);
+        split_value_gradient<Dim, NS>(out_s, bar_s, grad_s);
+        update(e, bar_v, grad_v, bar_s, grad_s, nullptr,
+               [&](double* ks) { row.interpolate(node_k.data(), stride, ks); });
+        return ok;
+      });
+      m_.to_stress_points.degenerate_rows = counts.degenerate;
+      m_.to_stress_points.pair_count = counts.pairs;
       if (sources) src.integrate(tau, m_.stress_point_sources, sp_s, sp_k);
       return;
     }
@@ -368,7 +383,7 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
   ViscoplasticSources<Dim>& src = *sources_;
   // The update of node i from the gradients of the stress points' state and their velocity
   // interpolated back (v_half, the material velocity at t^{n+1/2}).
-  auto update = [&](Index i, double (&grad_v)[Dim][Dim], double (&grad_s)[Dim][NS], double (&v_half)[Dim]) {
+  auto update = [&](Index i, double(&grad_v)[Dim][Dim], double(&grad_s)[Dim][NS], double(&v_half)[Dim]) {
     const auto iu = static_cast<std::size_t>(i);
     if (volumetric_rate_ != nullptr) {
       // The stress points' divergence by the corrected gradient, before fix (a) replaces a
@@ -465,35 +480,19 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
       // candidates at the stress points' positions and volumes of t^n, kept by step 1.
       const MovingOperators<Dim>& mo = *moving_;
       const Relation<Dim>& candidates = *mo.stress_points_near_nodes;
-      const Index nblocks = (nodes.size() + kOnTheFlyBlock - 1) / kOnTheFlyBlock;
-      std::atomic<Index> degenerate{0};
-      std::atomic<std::size_t> pairs{0};
-      exec::particle_for(
-          m_.policy, nblocks,
-          [&](Index blk) {
-            static thread_local CorrectedRow<Dim> row;
-            Index block_degenerate = 0;
-            std::size_t block_pairs = 0;
-            const Index end = std::min(nodes.size(), (blk + 1) * kOnTheFlyBlock);
-            for (Index i = blk * kOnTheFlyBlock; i < end; ++i) {
-              if (!row.evaluate(candidates.row(i), nodes.position[static_cast<std::size_t>(i)],
-                                mo.stress_point_position.data(), mo.stress_point_volume.data(), m_.kernel, mo.r2)) {
-                ++block_degenerate;
-              }
-              block_pairs += row.size();
-              double out_v[Dim + 1][Dim], out_s[Dim + 1][NS];
-              row.template apply<Dim, NS>(sp_v.data(), sp_s.data(), out_v, out_s);
-              double v_half[Dim], grad_v[Dim][Dim], unused[NS], grad_s[Dim][NS];
-              split_value_gradient<Dim, Dim>(out_v, v_half, grad_v);
-              split_value_gradient<Dim, NS>(out_s, unused, grad_s);
-              update(i, grad_v, grad_s, v_half);
-            }
-            if (block_degenerate > 0) degenerate.fetch_add(block_degenerate, std::memory_order_relaxed);
-            pairs.fetch_add(block_pairs, std::memory_order_relaxed);
-          },
-          exec::Schedule::even, nodes.size());
-      m_.to_nodes.degenerate_rows = degenerate.load();
-      m_.to_nodes.pair_count = pairs.load();
+      const RowCounts counts = rows_on_the_fly<Dim>(m_.policy, nodes.size(), [&](CorrectedRow<Dim>& row, Index i) {
+        const bool ok = row.evaluate(candidates.row(i), nodes.position[static_cast<std::size_t>(i)],
+                                     mo.stress_point_position.data(), mo.stress_point_volume.data(), m_.kernel, mo.r2);
+        double out_v[Dim + 1][Dim], out_s[Dim + 1][NS];
+        row.template apply<Dim, NS>(sp_v.data(), sp_s.data(), out_v, out_s);
+        double v_half[Dim], grad_v[Dim][Dim], unused[NS], grad_s[Dim][NS];
+        split_value_gradient<Dim, Dim>(out_v, v_half, grad_v);
+        split_value_gradient<Dim, NS>(out_s, unused, grad_s);
+        update(i, grad_v, grad_s, v_half);
+        return ok;
+      });
+      m_.to_nodes.degenerate_rows = counts.degenerate;
+      m_.to_nodes.pair_count = counts.pairs;
       moving_->note_degenerate(m_.degenerate_operator_rows(), c.t);
       if (sources) src.integrate(dt, m_.node_sources, node_s, m_.nodes.view(m_.fields.history));
       return;

@@ -174,8 +174,7 @@ void RebuildOperators<Dim>::run(const StepContext& c) {
   } else {
     rebuild_corrected_operator<Dim>(to_stress_points_, m_.stress_points.position, m_.nodes, m_.kernel,
                                     m_.to_stress_points, m_.policy);
-    rebuild_corrected_operator<Dim>(to_nodes_, m_.nodes.position, m_.stress_points, m_.kernel, m_.to_nodes,
-                                    m_.policy);
+    rebuild_corrected_operator<Dim>(to_nodes_, m_.nodes.position, m_.stress_points, m_.kernel, m_.to_nodes, m_.policy);
   }
   build_difference_gradient_into<Dim>(constrained_, constrained_positions_, m_.stress_points, m_.kernel,
                                       m_.constrained_gradient);

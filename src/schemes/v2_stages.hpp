@@ -37,8 +37,7 @@ class RebuildOperators final : public Stage {
   void run(const StepContext& context) override;
   std::size_t scratch_bytes() const override {
     return to_stress_points_.bytes() + to_nodes_.bytes() + constrained_.bytes() + node_neighbours_.bytes() +
-           moving_.bytes() +
-           sort_keys_.capacity() * sizeof(std::uint64_t) +
+           moving_.bytes() + sort_keys_.capacity() * sizeof(std::uint64_t) +
            (reordering_.nodes.capacity() + reordering_.stress_points.capacity()) * sizeof(Index);
   }
 

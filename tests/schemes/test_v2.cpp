@@ -13,10 +13,10 @@
 #include "../support/test_util.hpp"
 #include "case/case_builder.hpp"
 #include "io/state_archive.hpp"
-#include "schemes/simulation.hpp"
+#include "materials/perzyna_models.hpp"
 #include "operators/corrected_operator.hpp"
 #include "operators/corrected_row.hpp"
-#include "materials/perzyna_models.hpp"
+#include "schemes/simulation.hpp"
 #include "schemes/v2_stages.hpp"
 
 namespace rktsph {
@@ -139,7 +139,8 @@ TEST(V2, RebuiltOperatorsAreExactForLinearFieldsOnMovedParticles) {
     ASSERT_EQ(static_cast<Index>(row.size()), op.row(e).end - op.row(e).begin) << "the pairs of the stored row";
     double out[3][2];
     row.apply<2>(field.data(), out);
-    fly_value = std::max({fly_value, std::abs(out[0][0] - f(xe)), std::abs(out[0][1] - (-4.0 + 0.5 * xe[0] + 7.0 * xe[1]))});
+    fly_value =
+        std::max({fly_value, std::abs(out[0][0] - f(xe)), std::abs(out[0][1] - (-4.0 + 0.5 * xe[0] + 7.0 * xe[1]))});
     fly_grad = std::max({fly_grad, std::abs(out[1][0] - 2.0), std::abs(out[2][0] + 5.0), std::abs(out[1][1] - 0.5),
                          std::abs(out[2][1] - 7.0)});
   }
@@ -193,7 +194,8 @@ TEST(V2, OperatorsOnTheFlyAgreeWithStoredOperators) {
   };
   const double sigma_scale = 2.0e4, v_scale = 1.0;
   const auto sf = std::as_const(mf.nodes).view(mf.fields.stress), ss = std::as_const(ms.nodes).view(ms.fields.stress);
-  const auto vf = std::as_const(mf.nodes).view(mf.fields.velocity), vs = std::as_const(ms.nodes).view(ms.fields.velocity);
+  const auto vf = std::as_const(mf.nodes).view(mf.fields.velocity),
+             vs = std::as_const(ms.nodes).view(ms.fields.velocity);
   const auto kf = std::as_const(mf.nodes).view(mf.fields.history), ks = std::as_const(ms.nodes).view(ms.fields.history);
   double plastic = 0.0;
   for (Index i = 0; i < kf.size(); ++i) plastic = std::max(plastic, kf(i, 0));
@@ -202,7 +204,8 @@ TEST(V2, OperatorsOnTheFlyAgreeWithStoredOperators) {
                dk = worst(kf, ks, kf.components(), 1.0);
   double dx = 0.0;
   for (Index i = 0; i < mf.nodes.size(); ++i) {
-    dx = std::max(dx, (mf.nodes.position[static_cast<std::size_t>(i)] - ms.nodes.position[static_cast<std::size_t>(i)]).norm());
+    dx = std::max(
+        dx, (mf.nodes.position[static_cast<std::size_t>(i)] - ms.nodes.position[static_cast<std::size_t>(i)]).norm());
   }
   std::printf("on the fly vs stored: |ds| %.2e of 2e4 Pa, |dv| %.2e m/s, |dk| %.2e (eps_vp up to %.2e), |dx| %.2e m\n",
               ds, dv, dk, plastic, dx);
