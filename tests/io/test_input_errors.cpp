@@ -212,6 +212,21 @@ TEST(InputErrors, ParticleSortUnknownOrOutsideV2) {
   expect_error_at(run_case_text(dir, v1), line_of(v1, "sort"), "solver.sort", {"v2"});
 }
 
+TEST(InputErrors, OperatorStorageUnknownOutsideV2OrAgainstTheFilter) {
+  test::TempDir dir;
+  const std::string unknown = replace(kBase, "[time]", "[solver]\nversion = \"v2\"\noperators = \"cached\"\n[time]");
+  expect_error_at(run_case_text(dir, unknown), line_of(unknown, "operators"), "solver.operators",
+                  {"auto", "on_the_fly", "stored"});
+  const std::string v1 = replace(kBase, "[time]", "[solver]\noperators = \"stored\"\n[time]");
+  expect_error_at(run_case_text(dir, v1), line_of(v1, "operators"), "solver.operators", {"v2"});
+  // V1's velocity filter applies the stored operators.
+  const std::string filtered =
+      replace(kBase, "[time]",
+              "[solver]\nversion = \"v2\"\nvelocity_update = \"taylor_galerkin\"\noperators = \"on_the_fly\"\n[time]");
+  expect_error_at(run_case_text(dir, filtered), line_of(filtered, "operators"), "solver.operators",
+                  {"filter", "stored"});
+}
+
 TEST(InputErrors, DomainBoxNeedsBothCorners) {
   test::TempDir dir;
   const std::string text = replace(kBase, "[time]", "[solver]\nversion = \"v2\"\ndomain_min = [-1.0, -1.0]\n[time]");
