@@ -58,6 +58,23 @@ void Relation<Dim>::build(const std::vector<Vec<Dim>>& targets, const std::vecto
   ++version_;
 }
 
+template <int Dim>
+void Relation<Dim>::build_transpose(const Relation& other, Index rows) {
+  options_ = other.options_;
+  options_.sorted = true;  // targets appended in increasing order
+  const auto n = static_cast<std::size_t>(rows);
+  offsets_.assign(n + 1, 0);
+  for (const Index j : other.indices_) ++offsets_[static_cast<std::size_t>(j) + 1];
+  for (std::size_t j = 0; j < n; ++j) offsets_[j + 1] += offsets_[j];
+  indices_.resize(other.indices_.size());
+  static thread_local std::vector<Index> cursor;
+  cursor.assign(offsets_.begin(), offsets_.end() - 1);
+  for (Index a = 0; a < other.rows(); ++a) {
+    for (const Index j : other.row(a)) indices_[static_cast<std::size_t>(cursor[static_cast<std::size_t>(j)]++)] = a;
+  }
+  ++version_;
+}
+
 template class Relation<1>;
 template class Relation<2>;
 template class Relation<3>;

@@ -33,6 +33,12 @@ class Relation {
   void build(const std::vector<Vec<Dim>>& targets, const std::vector<Vec<Dim>>& sources, const RelationOptions& options,
              const exec::Threads& policy = {});
 
+  /// The transpose of `other` (built from targets T to sources S, with `rows` = |S|): for every
+  /// source of `other`, the targets whose rows hold it, sorted. The distance test is symmetric
+  /// (|x_t - x_s|^2 and |x_s - x_t|^2 are the same bits), so this is the relation a search from
+  /// S to T at other's radius finds, at the cost of a counting sort instead of a cell-list search.
+  void build_transpose(const Relation& other, Index rows);
+
   Index rows() const { return static_cast<Index>(offsets_.size()) - 1; }
   std::size_t pairs() const { return indices_.size(); }
   /// Sources of target a, in row order.

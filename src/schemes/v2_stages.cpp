@@ -97,7 +97,9 @@ void RebuildOperators<Dim>::build_relations(bool new_reference) {
   RelationOptions rel = operator_relation_options(m_.kernel);
   rel.radius += skin_;
   to_stress_points_.build(m_.stress_points.position, m_.nodes.position, rel, m_.policy);
-  to_nodes_.build(m_.nodes.position, m_.stress_points.position, rel, m_.policy);
+  // The nodes' candidates are the stress points' transposed (the same pairs, by a counting
+  // sort instead of a second search).
+  to_nodes_.build_transpose(to_stress_points_, m_.nodes.size());
   RelationOptions diff = difference_gradient_relation_options(m_.kernel);
   diff.radius += skin_;
   constrained_.build(constrained_positions_, m_.stress_points.position, diff, m_.policy);

@@ -73,6 +73,23 @@ TEST(Relation, MatchesABruteForceSearchAndRebuildsAfterAMove) {
   EXPECT_EQ(rel.version(), 4u);
 }
 
+// The transpose of a relation (targets T, sources S) is the relation a search from S to T
+// finds, row by row and in the same sorted order.
+TEST(Relation, TransposeEqualsTheReverseSearch) {
+  const test::ThreadCount threads(2);
+  const auto s = random_points(3000, 3);
+  const auto t = random_points(2500, 4);
+  Relation<2> forward, reverse, transposed;
+  forward.build(t, s, {0.25, 2, true});
+  reverse.build(s, t, {0.25, 2, true});
+  transposed.build_transpose(forward, static_cast<Index>(s.size()));
+  ASSERT_GT(reverse.pairs(), 10000u);
+  EXPECT_EQ(transposed.offsets(), reverse.offsets());
+  EXPECT_EQ(transposed.indices(), reverse.indices());
+  EXPECT_TRUE(transposed.options().sorted);
+  EXPECT_EQ(transposed.version(), 1u);
+}
+
 TEST(Relation, OperatorsFromARelationEqualThoseOfAFreshSearch) {
   Block<2> b;
   b.min = Vec<2>(0, 0);
