@@ -43,7 +43,6 @@ class CorrectedRow {
   }
 
   std::size_t size() const { return n_; }
-  bool degenerate() const { return !ok_; }
   /// The sources of the row, in candidate order.
   const Index* sources() const { return source_.data(); }
 
@@ -70,23 +69,9 @@ class CorrectedRow {
     }
   }
 
-  /// The corrected value (out[0]) and gradient (out[1 + d], d/dx_d) at the target of the field
-  /// of NF values per source (`field` + NF b holds source b's), eq. (3.2.3) applied as
-  /// M_a^{-1} sum_b w_b f_b.
-  template <int NF>
-  void apply(const double* field, double (&out)[N][NF]) const {
-    double s[N][NF] = {};
-    for (std::size_t k = 0; k < n_; ++k) {
-      const double* f = field + static_cast<std::size_t>(source_[k]) * NF;
-      for (int i = 0; i < N; ++i) {
-        const double wk = basis_[i][k];
-        for (int j = 0; j < NF; ++j) s[i][j] += wk * f[j];
-      }
-    }
-    finish<NF>(s, out);
-  }
-
-  /// apply() of two fields in one pass over the pairs (the state of V2's steps: velocity and
+  /// The corrected value (out[0]) and gradient (out[1 + d], d/dx_d) at the target of two fields
+  /// of NA and NB values per source (`field_a` + NA b holds source b's), eq. (3.2.3) applied as
+  /// M_a^{-1} sum_b w_b f_b, in one pass over the pairs (the state of V2's steps: velocity and
   /// stress), each pair's values summed as short vectors.
   template <int NA, int NB>
   void apply(const double* field_a, const double* field_b, double (&out_a)[N][NA], double (&out_b)[N][NB]) const {
@@ -138,7 +123,7 @@ class CorrectedRow {
  private:
   // Pairs are processed kLanes at a time, the last block padded with pairs of no volume (zero
   // weights): the loops then have no remainder, and their sums stay in vector registers (with a
-  // remainder GCC spilled the nine sums of M, a sixth of the V2 step).
+  // remainder GCC spilled the nine sums of M: BM_V2Step 45.5 -> 43.5 ms, docs/VALIDATION.md).
   static constexpr std::size_t kLanes = 8;
   std::size_t padded() const { return (n_ + kLanes - 1) / kLanes * kLanes; }
 
@@ -218,7 +203,7 @@ class CorrectedRow {
     shepard_ = M(0, 0);
     if constexpr (N == 3) {
       // By cofactors, the determinant from the same ones: Eigen's determinant() and inverse()
-      // computed it twice and took a sixth of the V2 step (measured).
+      // computed it twice (about a sixth of the V2 step in a perf profile of BM_V2Step).
       const double c00 = M(1, 1) * M(2, 2) - M(1, 2) * M(2, 1);
       const double c01 = M(1, 2) * M(2, 0) - M(1, 0) * M(2, 2);
       const double c02 = M(1, 0) * M(2, 1) - M(1, 1) * M(2, 0);

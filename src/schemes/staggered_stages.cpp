@@ -29,16 +29,32 @@ inline void split_value_gradient(const double (&out)[Dim + 1][NF], double (&valu
   }
 }
 
-// Rows [0, rows) of an operator evaluated on the fly, in blocks of kOnTheFlyBlock shared out to
-// the threads: per_row(row, a) evaluates row a into the thread's CorrectedRow, uses it and
-// returns false for a degenerate row. The degenerate rows and the pairs are counted (integer
-// sums: the same whatever the threads).
+// Where the on-the-fly rows of a step come from: each target's candidates, the targets, the
+// sources' positions and volumes (at t^n), and the sources' velocity and stress.
+template <int Dim>
+struct OnTheFlySources {
+  const Relation<Dim>& candidates;
+  const std::vector<Vec<Dim>>& targets;
+  const Vec<Dim>* position;
+  const double* volume;
+  const double* velocity;  // Dim values a source
+  const double* stress;    // kStressComponents<Dim> values a source
+};
+
+// The rows [0, targets) of an operator evaluated on the fly (method-notes §5.2), in blocks of
+// kOnTheFlyBlock shared out to the threads: each row is evaluated into the thread's
+// CorrectedRow and use(row, a, v, grad_v, sigma, grad_sigma) gets the corrected value and
+// gradient of the sources' velocity and stress at target a. The degenerate rows and the pairs
+// are counted (integer sums: the same whatever the threads).
 struct RowCounts {
   Index degenerate = 0;
   std::size_t pairs = 0;
 };
-template <int Dim, class PerRow>
-RowCounts rows_on_the_fly(const exec::Threads& policy, Index rows, PerRow&& per_row) {
+template <int Dim, class Use>
+RowCounts rows_on_the_fly(const exec::Threads& policy, const OnTheFlySources<Dim>& from,
+                          const CubicSplineKernel<Dim>& kernel, double r2, Use&& use) {
+  constexpr int NS = kStressComponents<Dim>;
+  const auto rows = static_cast<Index>(from.targets.size());
   const Index nblocks = (rows + kOnTheFlyBlock - 1) / kOnTheFlyBlock;
   std::atomic<Index> degenerate{0};
   std::atomic<std::size_t> pairs{0};
@@ -50,14 +66,37 @@ RowCounts rows_on_the_fly(const exec::Threads& policy, Index rows, PerRow&& per_
         std::size_t block_pairs = 0;
         const Index end = std::min(rows, (blk + 1) * kOnTheFlyBlock);
         for (Index a = blk * kOnTheFlyBlock; a < end; ++a) {
-          if (!per_row(row, a)) ++block_degenerate;
+          if (!row.evaluate(from.candidates.row(a), from.targets[static_cast<std::size_t>(a)], from.position,
+                            from.volume, kernel, r2)) {
+            ++block_degenerate;
+          }
           block_pairs += row.size();
+          double out_v[Dim + 1][Dim], out_s[Dim + 1][NS];
+          row.template apply<Dim, NS>(from.velocity, from.stress, out_v, out_s);
+          double v[Dim], grad_v[Dim][Dim], sigma[NS], grad_s[Dim][NS];
+          split_value_gradient<Dim, Dim>(out_v, v, grad_v);
+          split_value_gradient<Dim, NS>(out_s, sigma, grad_s);
+          use(row, a, v, grad_v, sigma, grad_s);
         }
         if (block_degenerate > 0) degenerate.fetch_add(block_degenerate, std::memory_order_relaxed);
         pairs.fetch_add(block_pairs, std::memory_order_relaxed);
       },
       exec::Schedule::even, rows);
   return {degenerate.load(), pairs.load()};
+}
+
+// V2 (method-notes §1.3, §5.2): particle i of `set` after its rotation over dt: the density by
+// continuity with the velocity gradient grad_v, the volume from the mass, the position moved
+// with the velocity v.
+template <int Dim>
+inline void continuity_and_move(ParticleSet<Dim>& set, std::size_t i, const double (&grad_v)[Dim][Dim], double dt,
+                                const double* v) {
+  double tr = 0.0;
+  for (int k = 0; k < Dim; ++k) tr += grad_v[k][k];
+  const double mass = set.volume[i] * set.density[i];
+  set.density[i] /= 1.0 + dt * tr;
+  set.volume[i] = mass / set.density[i];
+  for (int d = 0; d < Dim; ++d) set.position[i][d] += dt * v[d];
 }
 
 }  // namespace
@@ -190,12 +229,7 @@ void StressPointHalfStep<Dim, PressureTerm, Motion>::run(const StepContext& c) {
       // the half step (the flux and the source then act on the rotated stress); the
       // density by continuity over the step, with d at t^n; the position with v^{n+1/2}.
       jaumann_rotate<Dim>(grad_v, tau, bar_s);
-      double tr = 0.0;
-      for (int k = 0; k < Dim; ++k) tr += grad_v[k][k];
-      const double mass = sp.volume[eu] * sp.density[eu];
-      sp.density[eu] /= 1.0 + dt * tr;
-      sp.volume[eu] = mass / sp.density[eu];
-      for (int d = 0; d < Dim; ++d) sp.position[eu][d] += dt * sp_v(e, d);
+      continuity_and_move<Dim>(sp, eu, grad_v, dt, sp_v[e]);
     }
     for (int s = 0; s < NS; ++s) sp_s(e, s) = bar_s[s] + tau * dsig[s];
     if (sources) {
@@ -217,21 +251,18 @@ void StressPointHalfStep<Dim, PressureTerm, Motion>::run(const StepContext& c) {
       mo.resize(sp.size());
       const Relation<Dim>& candidates = *mo.nodes_near_stress_points;
       const ParticleSet<Dim>& nodes = m_.nodes;
-      const RowCounts counts = rows_on_the_fly<Dim>(m_.policy, sp.size(), [&](CorrectedRow<Dim>& row, Index e) {
-        const auto eu = static_cast<std::size_t>(e);
-        const bool ok = row.evaluate(candidates.row(e), sp.position[eu], nodes.position.data(), nodes.volume.data(),
-                                     m_.kernel, mo.r2);
-        mo.stress_point_position[eu] = sp.position[eu];
-        mo.stress_point_volume[eu] = sp.volume[eu];
-        double out_v[Dim + 1][Dim], out_s[Dim + 1][NS];
-        row.template apply<Dim, NS>(node_v.data(), node_s.data(), out_v, out_s);
-        double bar_v[Dim], bar_s[NS], grad_v[Dim][Dim], grad_s[Dim][NS];
-        split_value_gradient<Dim, Dim>(out_v, bar_v, grad_v);
-        split_value_gradient<Dim, NS>(out_s, bar_s, grad_s);
-        update(e, bar_v, grad_v, bar_s, grad_s, nullptr,
-               [&](double* ks) { row.interpolate(node_k.data(), stride, ks); });
-        return ok;
-      });
+      const OnTheFlySources<Dim> from{candidates,          sp.position,   nodes.position.data(),
+                                      nodes.volume.data(), node_v.data(), node_s.data()};
+      const RowCounts counts = rows_on_the_fly<Dim>(
+          m_.policy, from, m_.kernel, mo.r2,
+          [&](const CorrectedRow<Dim>& row, Index e, const double(&bar_v)[Dim], const double(&grad_v)[Dim][Dim],
+              double(&bar_s)[NS], const double(&grad_s)[Dim][NS]) {
+            const auto eu = static_cast<std::size_t>(e);
+            mo.stress_point_position[eu] = sp.position[eu];
+            mo.stress_point_volume[eu] = sp.volume[eu];
+            update(e, bar_v, grad_v, bar_s, grad_s, nullptr,
+                   [&](double* ks) { row.interpolate(node_k.data(), stride, ks); });
+          });
       m_.to_stress_points.degenerate_rows = counts.degenerate;
       m_.to_stress_points.pair_count = counts.pairs;
       if (sources) src.integrate(tau, m_.stress_point_sources, sp_s, sp_k);
@@ -455,12 +486,7 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
       // V2: the Jaumann rotation over the step with the spin of v^{n+1/2}; the density by
       // continuity; the position moved with the displacement (x - X = u).
       jaumann_rotate<Dim>(grad_v, dt, s);
-      double tr = 0.0;
-      for (int k = 0; k < Dim; ++k) tr += grad_v[k][k];
-      const double mass = nodes.volume[iu] * nodes.density[iu];
-      nodes.density[iu] /= 1.0 + dt * tr;
-      nodes.volume[iu] = mass / nodes.density[iu];
-      for (int d = 0; d < Dim; ++d) nodes.position[iu][d] += dt * v_half[d];
+      continuity_and_move<Dim>(nodes, iu, grad_v, dt, v_half);
     }
     if (sources) {
       double* start = src.sigma_start(i);
@@ -480,17 +506,13 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
       // candidates at the stress points' positions and volumes of t^n, kept by step 1.
       const MovingOperators<Dim>& mo = *moving_;
       const Relation<Dim>& candidates = *mo.stress_points_near_nodes;
-      const RowCounts counts = rows_on_the_fly<Dim>(m_.policy, nodes.size(), [&](CorrectedRow<Dim>& row, Index i) {
-        const bool ok = row.evaluate(candidates.row(i), nodes.position[static_cast<std::size_t>(i)],
-                                     mo.stress_point_position.data(), mo.stress_point_volume.data(), m_.kernel, mo.r2);
-        double out_v[Dim + 1][Dim], out_s[Dim + 1][NS];
-        row.template apply<Dim, NS>(sp_v.data(), sp_s.data(), out_v, out_s);
-        double v_half[Dim], grad_v[Dim][Dim], unused[NS], grad_s[Dim][NS];
-        split_value_gradient<Dim, Dim>(out_v, v_half, grad_v);
-        split_value_gradient<Dim, NS>(out_s, unused, grad_s);
-        update(i, grad_v, grad_s, v_half);
-        return ok;
-      });
+      const OnTheFlySources<Dim> from{
+          candidates,  nodes.position, mo.stress_point_position.data(), mo.stress_point_volume.data(),
+          sp_v.data(), sp_s.data()};
+      const RowCounts counts =
+          rows_on_the_fly<Dim>(m_.policy, from, m_.kernel, mo.r2,
+                               [&](const CorrectedRow<Dim>&, Index i, double(&v_half)[Dim], double(&grad_v)[Dim][Dim],
+                                   double(&)[NS], double(&grad_s)[Dim][NS]) { update(i, grad_v, grad_s, v_half); });
       m_.to_nodes.degenerate_rows = counts.degenerate;
       m_.to_nodes.pair_count = counts.pairs;
       moving_->note_degenerate(m_.degenerate_operator_rows(), c.t);
