@@ -336,6 +336,14 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     } else {
       s->fail("free_surface", fmt::format("unknown value '{}' (known: detect, faces)", surface));
     }
+    c.surface_refresh = s->number("surface_refresh", 0.1);
+    s->require(c.surface_refresh >= 0.0 && c.surface_refresh <= 0.5, "surface_refresh",
+               fmt::format("must lie in [0, 0.5] (a multiple of dx; 0 evaluates every node every step), got {}",
+                           c.surface_refresh));
+    if (s->has("surface_refresh")) {
+      s->require(c.detect_free_surface, "surface_refresh",
+                 "applies to the detected free surface (solver.free_surface = \"detect\", V2 in 2D/3D)");
+    }
     const std::string reseed = s->string("reseed", "off");
     if (reseed == "off")
       c.reseed = ReseedSetting::off;

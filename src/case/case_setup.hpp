@@ -253,6 +253,9 @@ struct CaseSetup {
   /// current positions every step with its normals, the stress rotated to sigma.n = 0 there
   /// (solver.free_surface = "faces" | "detect").
   bool detect_free_surface = false;
+  /// The detection's settled interior (method-notes §3.6): every node is evaluated again once
+  /// some node has moved surface_refresh * dx since the last full pass; 0: every step.
+  double surface_refresh = 0.1;
   SourceCoupling coupling = SourceCoupling::additive;
   /// V2: the stress points re-seeded from the node cloud (method-notes §5.2, "Regularisation";
   /// solver.reseed): never, when the sets drift apart (eq. (5.2.4): more particles than after

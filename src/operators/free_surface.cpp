@@ -1,5 +1,7 @@
 #include "operators/free_surface.hpp"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <span>
@@ -86,6 +88,82 @@ struct PairArrays {
   }
 };
 
+// The pre-screen of step 1 in single precision: lambda_min of B from the same pairs, 16 pairs a
+// vector operation (twice double's lanes, and float's square root and division are cheaper).
+// Only a node whose float eigenvalue lies clearly above interior_above is settled by it; every
+// other node is evaluated again in double, so that flags and normals are those of the double
+// evaluation. The float sums err by ~1e-5 at most (some 20 terms of O(1), each within a few ulp
+// of 6e-8), far inside kScreenMargin.
+inline constexpr double kScreenMargin = 1e-3;
+
+template <int Dim>
+struct ScreenArrays {
+  static constexpr std::size_t kLanes = 16;
+  std::vector<float> x[Dim];  // x_I - x_J
+  std::vector<float> d2;
+  std::vector<float> volume;
+
+  // Returns the smallest eigenvalue of B (the symmetric B of PairArrays::moments).
+  double lambda(std::span<const Index> row, const Vec<Dim>& xi, const ParticleSet<Dim>& set, double r2, double inv_h,
+                double alpha) {
+    const std::size_t m = row.size() + kLanes;
+    if (d2.size() < m) {
+      for (auto& v : x) v.resize(m);
+      d2.resize(m);
+      volume.resize(m);
+    }
+    std::size_t count = 0;
+    for (const Index j : row) {
+      const auto ju = static_cast<std::size_t>(j);
+      const Vec<Dim> x_ij = xi - set.position[ju];
+      const double s = x_ij.squaredNorm();
+      for (int d = 0; d < Dim; ++d) x[d][count] = static_cast<float>(x_ij[d]);
+      d2[count] = static_cast<float>(s);
+      volume[count] = static_cast<float>(set.volume[ju]);
+      count += s < r2 ? 1 : 0;
+    }
+    const std::size_t padded = (count + kLanes - 1) / kLanes * kLanes;
+    for (std::size_t k = count; k < padded; ++k) {
+      for (int d = 0; d < Dim; ++d) x[d][k] = 0.0f;
+      d2[k] = 0.0f;
+      volume[k] = 0.0f;  // no volume: no contribution
+    }
+    // h W'(r)/r of the cubic spline (CubicSplineKernel::value_and_scaled_derivative) times inv_h.
+    const float a = static_cast<float>(alpha * inv_h * inv_h), ih = static_cast<float>(inv_h);
+    // The Dim (Dim + 1) / 2 entries of the symmetric B, row by row.
+    constexpr int kEntries = Dim * (Dim + 1) / 2;
+    constexpr std::array<int, 6> kRow =
+        Dim == 3 ? std::array<int, 6>{0, 0, 0, 1, 1, 2} : std::array<int, 6>{0, 0, 1, 0, 0, 0};
+    constexpr std::array<int, 6> kCol =
+        Dim == 3 ? std::array<int, 6>{0, 1, 2, 1, 2, 2} : std::array<int, 6>{0, 1, 1, 0, 0, 0};
+    float sb[kEntries][kLanes] = {};
+    const float* s2 = d2.data();
+    const float* V = volume.data();
+    const float* xs[Dim];
+    for (int d = 0; d < Dim; ++d) xs[d] = x[d].data();
+    for (std::size_t k0 = 0; k0 < padded; k0 += kLanes) {
+#pragma omp simd
+      for (std::size_t l = 0; l < kLanes; ++l) {
+        const std::size_t k = k0 + l;
+        const float q = std::sqrt(s2[k]) * ih;
+        const float t = 2.0f - q;
+        const float inner = a * (-2.0f + 1.5f * q);
+        const float outer = -0.5f * a * t * t / std::max(q, 1.0f);
+        const float f = V[k] * (q < 1.0f ? inner : outer);
+        for (int c = 0; c < kEntries; ++c) sb[c][l] += f * xs[kRow[c]][k] * xs[kCol[c]][k];
+      }
+    }
+    Mat<Dim> B;
+    for (int c = 0; c < kEntries; ++c) {
+      double sum = 0.0;
+      for (std::size_t l = 0; l < kLanes; ++l) sum += static_cast<double>(sb[c][l]);
+      B(kRow[c], kCol[c]) = -sum;
+      B(kCol[c], kRow[c]) = -sum;
+    }
+    return smallest_eigenvalue<Dim>(B);
+  }
+};
+
 }  // namespace
 
 template <int Dim>
@@ -97,21 +175,69 @@ void detect_free_surface(const ParticleSet<Dim>& set, const Relation<Dim>& relat
   FreeSurfaceScratch<Dim> local;
   FreeSurfaceScratch<Dim>& work = scratch != nullptr ? *scratch : local;
   const Index n = set.size();
+  const auto nu = static_cast<std::size_t>(n);
   const double h = kernel.h();
   const double inv_h = kernel.inv_h(), alpha = kernel.alpha();
   const double r2 = kernel.support_radius() * kernel.support_radius();
   const double near2 = 2.0 * h * h;  // (sqrt(2) h)^2
-  flags.assign(static_cast<std::size_t>(n), 0);
-  normals.assign(static_cast<std::size_t>(n), Vec<Dim>::Zero());
   std::vector<double>& lambda = work.lambda;
-  lambda.assign(static_cast<std::size_t>(n), 0.0);
+  // The settled interior (method-notes §3.6) is skipped unless some node has moved or changed
+  // its volume enough since the last full pass. A partial pass needs that pass's state and the
+  // caller's flags and normals as this function left them (zero at every settled node).
+  bool full = true;
+  if (options.refresh_displacement > 0.0 && work.settled.size() == nu && work.reference_position.size() == nu &&
+      work.reference_volume.size() == nu && lambda.size() == nu && flags.size() == nu && normals.size() == nu) {
+    // One vectorised sweep: any node moved more than refresh_displacement, or whose volume
+    // changed by more than refresh_volume of its reference (a frozen node, volume 0, counts).
+    const double d2 = options.refresh_displacement * options.refresh_displacement, dv = options.refresh_volume;
+    const Vec<Dim>* x = set.position.data();
+    const Vec<Dim>* x0 = work.reference_position.data();
+    const double* v = set.volume.data();
+    const double* v0 = work.reference_volume.data();
+    int due = 0;
+#pragma omp simd reduction(| : due)
+    for (std::size_t i = 0; i < nu; ++i) {
+      double moved2 = 0.0;
+      for (int d = 0; d < Dim; ++d) moved2 += (x[i][d] - x0[i][d]) * (x[i][d] - x0[i][d]);
+      due |= static_cast<int>(moved2 > d2) | static_cast<int>(std::abs(v[i] - v0[i]) > dv * v0[i]);
+    }
+    full = due != 0;
+  }
+  work.last_full = full;
+  std::vector<Index>& active = work.active;
+  if (full) {
+    ++work.full_passes;
+    flags.assign(nu, 0);
+    normals.assign(nu, Vec<Dim>::Zero());
+    lambda.assign(nu, 0.0);
+    work.settled.assign(nu, 0);
+  } else {
+    ++work.partial_passes;
+    for (const Index i : active) {
+      flags[static_cast<std::size_t>(i)] = 0;
+      normals[static_cast<std::size_t>(i)].setZero();
+    }
+  }
+  // The nodes this pass evaluates: every node, or the active ones (those not settled).
+  const Index count = full ? n : static_cast<Index>(active.size());
+  const Index* which = full ? nullptr : active.data();
+  std::uint8_t* settled = work.settled.data();
   // Steps 1-3: B, the first normal, the pre-screen and the umbrella scan of the candidates.
-  exec::particle_for(policy, n, [&](Index i) {
+  exec::particle_for(policy, count, [&](Index k) {
+    const Index i = which != nullptr ? which[k] : k;
     const auto iu = static_cast<std::size_t>(i);
     const Vec<Dim>& xi = set.position[iu];
-    // The neighbours in the support, gathered branch-free into arrays (a coincident particle,
+    // Most nodes are settled by the single-precision screen; the rest are evaluated in double:
+    // the neighbours in the support gathered branch-free into arrays (a coincident particle,
     // d2 = 0, contributes nothing: its x_IJ is zero), then B and g summed in loops the compiler
     // vectorises (the square root and the kernel's piece 8 pairs at a time).
+    static thread_local ScreenArrays<Dim> screen;
+    const double screened = screen.lambda(relation.row(i), xi, set, r2, inv_h, alpha);
+    if (screened > options.interior_above + kScreenMargin) {
+      lambda[iu] = screened;  // only ever compared with the thresholds, which it clears
+      if (full) settled[iu] = screened > options.settled_above && (excluded.empty() || excluded[iu] == 0) ? 1 : 0;
+      return;
+    }
     static thread_local PairArrays<Dim> pairs;
     pairs.gather(relation.row(i), xi, set, r2);
     Mat<Dim> B;
@@ -121,9 +247,9 @@ void detect_free_surface(const ParticleSet<Dim>& set, const Relation<Dim>& relat
     // The rest concerns candidates only: an interior node (most of a body) stops here.
     if (lambda[iu] > options.interior_above) return;
     if (!excluded.empty() && excluded[iu] != 0) return;
-    Vec<Dim> nu = std::abs(B.determinant()) > 1e-12 ? Vec<Dim>(-(B.inverse() * g)) : Vec<Dim>(-g);
-    const double len = nu.norm();
-    const Vec<Dim> normal = len > 0.0 ? Vec<Dim>(nu / len) : Vec<Dim>::Zero();
+    Vec<Dim> nu_i = std::abs(B.determinant()) > 1e-12 ? Vec<Dim>(-(B.inverse() * g)) : Vec<Dim>(-g);
+    const double len = nu_i.norm();
+    const Vec<Dim> normal = len > 0.0 ? Vec<Dim>(nu_i / len) : Vec<Dim>::Zero();
     bool surface = false;
     if (lambda[iu] <= options.surface_below) {
       surface = true;
@@ -159,36 +285,60 @@ void detect_free_surface(const ParticleSet<Dim>& set, const Relation<Dim>& relat
       normals[iu] = normal;
     }
   });
+  if (full && options.refresh_displacement > 0.0) {
+    work.reference_position.assign(set.position.begin(), set.position.end());
+    work.reference_volume.assign(set.volume.begin(), set.volume.end());
+    active.clear();
+    for (Index i = 0; i < n; ++i) {
+      if (settled[static_cast<std::size_t>(i)] == 0) active.push_back(i);
+    }
+  }
+  // Every later step reads and writes only the flagged nodes' own entries (and their neighbours'
+  // flags, previous flags and positions, which no step writes), so they run in place over the
+  // nodes just evaluated: the flagged ones are among them.
+  //
   // Step 5: temporal coherence. A node not on the surface at the last step joins it only next to
   // one that was, or when its support is plainly one-sided (lambda <= surface_below).
   if (!previous.empty()) {
-    std::vector<std::uint8_t>& keep = work.keep;
-    keep = flags;
-    exec::particle_for(policy, n, [&](Index i) {
+    std::vector<std::uint8_t>& drop = work.keep;
+    drop.assign(static_cast<std::size_t>(count), 0);
+    exec::particle_for(policy, count, [&](Index k) {
+      const Index i = which != nullptr ? which[k] : k;
       const auto iu = static_cast<std::size_t>(i);
       if (flags[iu] == 0 || previous[iu] != 0 || lambda[iu] <= options.surface_below) return;
       bool near_surface = false;
       for (const Index j : relation.row(i)) near_surface = near_surface || previous[static_cast<std::size_t>(j)] != 0;
-      if (!near_surface) keep[iu] = 0;
+      if (!near_surface) drop[static_cast<std::size_t>(k)] = 1;
     });
-    for (Index i = 0; i < n; ++i) {
-      if (keep[static_cast<std::size_t>(i)] == 0) normals[static_cast<std::size_t>(i)].setZero();
+    for (Index k = 0; k < count; ++k) {
+      if (drop[static_cast<std::size_t>(k)] == 0) continue;
+      const auto iu = static_cast<std::size_t>(which != nullptr ? which[k] : k);
+      flags[iu] = 0;
+      normals[iu].setZero();
     }
-    flags.swap(keep);
   }
   // Step 4 (2D): the improved normal, from the chords to the two adjacent surface nodes: the
   // nearest partner on either side along the tangent of the first normal, a partner being a
   // flagged neighbour or an excluded one that is not plainly interior (a wall's surface node,
   // where the free surface meets a wall). Each chord's perpendicular is turned to the first
   // normal's side; their mean is the normal. Where the two perpendiculars differ by more than
-  // kCornerTurn the node is a corner: two faces meet there and no single normal holds.
-  if (corners != nullptr) corners->assign(static_cast<std::size_t>(n), 0);
+  // kCornerTurn the node is a corner: two faces meet there and no single normal holds. The
+  // first normals are kept until every node has its improved one (a node reads only its own).
+  if (corners != nullptr) {
+    if (full || corners->size() != nu) {
+      corners->assign(nu, 0);
+    } else {
+      for (Index k = 0; k < count; ++k) (*corners)[static_cast<std::size_t>(which[k])] = 0;
+    }
+  }
   if constexpr (Dim == 2) {
     const double corner_cos = std::cos(kCornerTurn);
     std::vector<Vec<Dim>>& improved = work.improved;
-    improved = normals;
-    exec::particle_for(policy, n, [&](Index i) {
+    improved.resize(static_cast<std::size_t>(count));
+    exec::particle_for(policy, count, [&](Index k) {
+      const Index i = which != nullptr ? which[k] : k;
       const auto iu = static_cast<std::size_t>(i);
+      improved[static_cast<std::size_t>(k)] = normals[iu];
       if (flags[iu] == 0) return;
       const Vec<Dim> n0 = normals[iu];
       const Vec<Dim> tangent(-n0[1], n0[0]);
@@ -220,10 +370,13 @@ void detect_free_surface(const ParticleSet<Dim>& set, const Relation<Dim>& relat
       }
       if (found == 0) return;
       const Vec<Dim> sum = found == 2 ? Vec<Dim>(p[0] + p[1]) : p[0];
-      if (sum.norm() > 0.0) improved[iu] = sum / sum.norm();
+      if (sum.norm() > 0.0) improved[static_cast<std::size_t>(k)] = sum / sum.norm();
       if (found == 2 && corners != nullptr && p[0].dot(p[1]) < corner_cos) (*corners)[iu] = 1;
     });
-    normals.swap(improved);
+    for (Index k = 0; k < count; ++k) {
+      const auto iu = static_cast<std::size_t>(which != nullptr ? which[k] : k);
+      if (flags[iu] != 0) normals[iu] = improved[static_cast<std::size_t>(k)];
+    }
   }
 }
 

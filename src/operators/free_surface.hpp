@@ -32,14 +32,36 @@ inline constexpr double kCornerTurn = 1.0471975511965976;  // 60 degrees
 struct FreeSurfaceOptions {
   double surface_below = 0.2;    // lambda_min of B at or below which a node is on the surface
   double interior_above = 0.75;  // lambda_min above which it is interior without the scan
+  // Settled interior (method-notes §3.6, "Settled interior"): with a work space kept between
+  // calls and refresh_displacement > 0, a node whose lambda_min exceeded settled_above at the
+  // last full pass is not evaluated again (it stays interior) until some node has moved more
+  // than refresh_displacement (m) or changed its volume by more than the fraction refresh_volume
+  // since that pass; then every node is evaluated again. 0 evaluates every node every call.
+  double refresh_displacement = 0.0;
+  double refresh_volume = 0.02;
+  double settled_above = 0.85;
 };
 
-/// Work space of detect_free_surface, kept by its caller between steps (no allocation once grown).
+/// Work space of detect_free_surface, kept by its caller between steps (no allocation once grown),
+/// and the state of the settled interior: each node's lambda_min, and the positions, volumes and
+/// settled flags of the last full pass (saved with a checkpoint, permuted with the nodes).
 template <int Dim>
 struct FreeSurfaceScratch {
   std::vector<double> lambda;
   std::vector<std::uint8_t> keep;
   std::vector<Vec<Dim>> improved;
+  std::vector<std::uint8_t> settled;
+  std::vector<Index> active;  // the nodes not settled at the last full pass
+  std::vector<Vec<Dim>> reference_position;
+  std::vector<double> reference_volume;
+  std::int64_t full_passes = 0;     // calls that evaluated every node
+  std::int64_t partial_passes = 0;  // calls that skipped the settled interior
+  bool last_full = true;            // whether the last call was a full pass
+  std::size_t bytes() const {
+    return lambda.capacity() * sizeof(double) + keep.capacity() + improved.capacity() * sizeof(Vec<Dim>) +
+           settled.capacity() + active.capacity() * sizeof(Index) + reference_position.capacity() * sizeof(Vec<Dim>) +
+           reference_volume.capacity() * sizeof(double);
+  }
 };
 
 /// Flags (1 = free surface) and outward unit normals of every particle of `set`, from

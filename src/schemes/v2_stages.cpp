@@ -270,8 +270,10 @@ void DetectFreeSurface<Dim>::run(const StepContext&) {
   for (std::size_t i = 0; i < nn; ++i) {
     if (m_.nodes.volume[i] == 0.0) excluded_[i] = 1;
   }
-  detect_free_surface<Dim>(m_.nodes, rebuild_.node_neighbours(), m_.kernel, FreeSurfaceOptions{}, previous_, excluded_,
-                           flags_, normals_, m_.policy, &corners_, &scratch_);
+  FreeSurfaceOptions options;
+  options.refresh_displacement = m_.setup.surface_refresh * m_.dx();
+  detect_free_surface<Dim>(m_.nodes, rebuild_.node_neighbours(), m_.kernel, options, previous_, excluded_, flags_,
+                           normals_, m_.policy, &corners_, &scratch_);
   unflagged_by_bodies_ = 0;
   if constexpr (Dim == 2) {
     // Next to a body the support is cut by it, not by a free surface: a flag whose normal
@@ -327,12 +329,41 @@ template <int Dim>
 void DetectFreeSurface<Dim>::save(io::StateArchive& a, const std::string& prefix) const {
   a.put_integer(prefix + "detections", detections_);
   a.put(prefix + "corners", corners_);  // node shifting reads them before the next detection
+  // The settled interior of the last full pass, so that a resumed run skips the nodes, and
+  // evaluates all of them again, at the steps the uninterrupted run does.
+  if (scratch_.settled.empty()) return;
+  a.put(prefix + "settled", scratch_.settled);
+  a.put(prefix + "lambda", scratch_.lambda);
+  a.put(prefix + "reference_volume", scratch_.reference_volume);
+  std::vector<double> flat;
+  flat.reserve(scratch_.reference_position.size() * Dim);
+  for (const auto& x : scratch_.reference_position) {
+    for (int d = 0; d < Dim; ++d) flat.push_back(x[d]);
+  }
+  a.put(prefix + "reference_position", std::move(flat));
 }
 
 template <int Dim>
 void DetectFreeSurface<Dim>::load(const io::StateArchive& a, const std::string& prefix) {
   detections_ = a.integer(prefix + "detections");
   if (a.has(prefix + "corners")) corners_ = a.bytes(prefix + "corners");
+  scratch_.settled.clear();  // without a saved pass the next detection is a full one
+  if (!a.has(prefix + "settled")) return;
+  scratch_.settled = a.bytes(prefix + "settled");
+  scratch_.lambda = a.doubles(prefix + "lambda");
+  scratch_.reference_volume = a.doubles(prefix + "reference_volume");
+  const auto& flat = a.doubles(prefix + "reference_position");
+  scratch_.reference_position.resize(flat.size() / Dim);
+  for (std::size_t i = 0; i < scratch_.reference_position.size(); ++i) {
+    for (int d = 0; d < Dim; ++d) scratch_.reference_position[i][d] = flat[i * Dim + static_cast<std::size_t>(d)];
+  }
+  scratch_.active.clear();
+  for (std::size_t i = 0; i < scratch_.settled.size(); ++i) {
+    if (scratch_.settled[i] == 0) scratch_.active.push_back(static_cast<Index>(i));
+  }
+  // A partial pass rewrites the flags and normals of the active nodes only: the others are 0.
+  flags_.assign(scratch_.settled.size(), 0);
+  normals_.assign(scratch_.settled.size(), Vec<Dim>::Zero());
 }
 
 template <int Dim>
@@ -344,7 +375,9 @@ void DetectFreeSurface<Dim>::reordered(const Reordering& r) {
   permute_rows(excluded_, r.nodes);  // it keeps the deactivated nodes
   permute_rows(corners_, r.nodes);   // node shifting reads them before the next detection
   // flags_, normals_ and surface_ are not read before the next detection rewrites them (the
-  // sort runs before it in the step; a resume detects before the step's end needs them).
+  // sort runs before it in the step; a resume detects before the step's end needs them), which
+  // is a full pass: the settled interior is forgotten.
+  scratch_.settled.clear();
 }
 
 template <int Dim>

@@ -127,8 +127,7 @@ class DetectFreeSurface final : public Stage {
   void run(const StepContext& context) override;
   std::size_t scratch_bytes() const override {
     return previous_.capacity() + flags_.capacity() + excluded_.capacity() + corners_.capacity() +
-           normals_.capacity() * sizeof(Vec<Dim>) + scratch_.lambda.capacity() * sizeof(double) +
-           scratch_.keep.capacity() + scratch_.improved.capacity() * sizeof(Vec<Dim>);
+           normals_.capacity() * sizeof(Vec<Dim>) + scratch_.bytes();
   }
   void save(io::StateArchive& archive, const std::string& prefix) const override;
   void load(const io::StateArchive& archive, const std::string& prefix) override;
@@ -143,6 +142,8 @@ class DetectFreeSurface final : public Stage {
   std::vector<std::pair<std::string, double>> report() const override {
     return {{"surface_nodes_last_step", static_cast<double>(surface_nodes_)},
             {"detection_seconds", seconds_},
+            {"detection_full_passes", static_cast<double>(scratch_.full_passes)},
+            {"detection_partial_passes", static_cast<double>(scratch_.partial_passes)},
             {"unflagged_next_to_bodies_last_step", static_cast<double>(unflagged_by_bodies_)}};
   }
 

@@ -227,6 +227,16 @@ TEST(InputErrors, OperatorStorageUnknownOutsideV2OrAgainstTheFilter) {
                   {"filter", "stored"});
 }
 
+TEST(InputErrors, SurfaceRefreshOutOfRangeOrWithoutDetection) {
+  test::TempDir dir;
+  const std::string negative = replace(kBase, "[time]", "[solver]\nversion = \"v2\"\nsurface_refresh = -0.1\n[time]");
+  expect_error_at(run_case_text(dir, negative), line_of(negative, "surface_refresh"), "solver.surface_refresh",
+                  {"[0, 0.5]"});
+  const std::string faces =
+      replace(kBase, "[time]", "[solver]\nversion = \"v2\"\nfree_surface = \"faces\"\nsurface_refresh = 0.1\n[time]");
+  expect_error_at(run_case_text(dir, faces), line_of(faces, "surface_refresh"), "solver.surface_refresh", {"detect"});
+}
+
 TEST(InputErrors, DomainBoxNeedsBothCorners) {
   test::TempDir dir;
   const std::string text = replace(kBase, "[time]", "[solver]\nversion = \"v2\"\ndomain_min = [-1.0, -1.0]\n[time]");

@@ -2,6 +2,7 @@
 // rotation (§3.7): the flags of a square and of a disc, outward normals, and sigma.n = 0.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 
@@ -107,6 +108,58 @@ TEST(FreeSurface, ExcludedNodesAreNeverFlagged) {
   std::vector<Vec<2>> normals;
   detect_free_surface<2>(c.set, rel, kernel, {}, {}, excluded, flags, normals);
   EXPECT_EQ(count(flags), 0);
+}
+
+// The settled interior (method-notes §3.6): with a kept work space and a refresh distance, the
+// second call on an unchanged disc evaluates only the nodes that were not settled and returns
+// the same flags and normals; a node moved by more than the distance, a volume changed by more
+// than 2 %, or a node frozen (volume 0) makes the next call a full pass again.
+TEST(FreeSurface, TheSettledInteriorIsSkippedUntilANodeMovesOrSwells) {
+  const double dx = 0.1;
+  Cloud c = lattice_cloud(dx, 10, [](const Vec<2>& x) { return x.norm() < 0.95; });
+  const CubicSplineKernel<2> kernel(1.2 * dx);
+  Relation<2> rel;
+  rel.build(c.set.position, c.set.position, {kernel.support_radius() + 0.05, 1, true});
+  FreeSurfaceOptions options;
+  options.refresh_displacement = 0.1 * dx;
+  FreeSurfaceScratch<2> work;
+  std::vector<std::uint8_t> flags, corners;
+  std::vector<Vec<2>> normals;
+  auto detect = [&] {
+    detect_free_surface<2>(c.set, rel, kernel, options, {}, {}, flags, normals, exec::Threads{}, &corners, &work);
+    return work.last_full;
+  };
+  EXPECT_TRUE(detect()) << "the first pass is full";
+  const auto full_flags = flags;
+  const auto full_normals = normals;
+  const long settled = std::count(work.settled.begin(), work.settled.end(), std::uint8_t{1});
+  EXPECT_GT(settled, c.set.size() / 2) << "most of the disc is settled";
+  EXPECT_EQ(static_cast<long>(work.active.size()), c.set.size() - settled);
+  EXPECT_FALSE(detect()) << "nothing moved: a partial pass";
+  EXPECT_EQ(flags, full_flags);
+  EXPECT_EQ(normals, full_normals);
+  EXPECT_GT(count(flags), 0);
+  // Every node moved by 0.09 dx: still partial. The centre node by 0.11 dx more: full.
+  for (auto& x : c.set.position) x[0] += 0.09 * dx;
+  EXPECT_FALSE(detect());
+  const std::size_t centre =
+      static_cast<std::size_t>(std::min_element(c.set.position.begin(), c.set.position.end(),
+                                                [](const Vec<2>& a, const Vec<2>& b) { return a.norm() < b.norm(); }) -
+                               c.set.position.begin());
+  c.set.position[centre][1] += 0.11 * dx;
+  EXPECT_TRUE(detect());
+  EXPECT_FALSE(detect());
+  c.set.volume[centre] *= 1.019;
+  EXPECT_FALSE(detect()) << "1.9 % of volume";
+  c.set.volume[centre] *= 1.002;
+  EXPECT_TRUE(detect()) << "2.1 % of volume";
+  c.set.volume[centre] = 0.0;
+  EXPECT_TRUE(detect()) << "a node frozen";
+  EXPECT_EQ(work.full_passes, 4);
+  EXPECT_EQ(work.partial_passes, 4);
+  // Without the refresh distance every pass is full.
+  options.refresh_displacement = 0.0;
+  EXPECT_TRUE(detect());
 }
 
 TEST(FreeSurface, TheTractionFreeRotationZeroesSigmaNAndKeepsTheTangentialStress) {

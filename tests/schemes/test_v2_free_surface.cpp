@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <tuple>
 
 #include <fmt/format.h>
 
@@ -14,6 +15,7 @@
 #include "case/case_builder.hpp"
 #include "case/case_reader.hpp"
 #include "schemes/simulation.hpp"
+#include "schemes/v2_stages.hpp"
 
 namespace rktsph {
 namespace {
@@ -162,6 +164,52 @@ TEST(V2FreeSurface, ADetectedSurfaceFollowsTheLatticeFacesOnAnAlignedBlock) {
   std::printf("detected against lattice faces: sigma_yy rms %.2g rho g H, velocity %.2g of its peak\n", rms, dv / vmax);
   EXPECT_LT(rms, 1e-4);
   EXPECT_LT(dv / vmax, 1e-2);
+}
+
+// The settled interior (method-notes §3.6): a detection that skips the nodes found well inside
+// the body at its last full pass, until some node has moved surface_refresh dx, gives the flags
+// and normals of a full detection every step. Case 9's collapsing slope (the block falls and
+// spreads along the base against the wall; its surface changes everywhere) run to 1 s both ways
+// is bit-identical, while most detections skipped the interior.
+TEST(V2FreeSurface, TheSettledInteriorGivesTheSurfaceOfAFullDetectionEveryStep) {
+  const test::ThreadCount threads(1);
+  auto run = [](double refresh) {
+    const std::string file = std::string(RKTSPH_SOURCE_DIR) + "/cases/thesis/09_low_cohesion_slope_2d.toml";
+    auto sim = std::make_unique<Simulation<2>>(read_case<2>(load_case_document(
+        file, {"geometry.spacing=0.5", fmt::format("solver.surface_refresh={}", refresh), "output.times=[]"})));
+    long steps = 0, surface_steps = 0;
+    const Field<double, 1> flag = sim->nodes().template find<double, 1>("free_surface");
+    while (sim->time() < 1.0 - 1e-12) {
+      sim->step();
+      ++steps;
+      for (Index i = 0; i < sim->nodes().size(); ++i) surface_steps += sim->nodes().view(flag)(i, 0) != 0.0 ? 1 : 0;
+    }
+    double full = 0.0, partial = 0.0;
+    for (const auto& [key, value] : sim->scheme().find<DetectFreeSurface<2>>()->report()) {
+      if (key == "detection_full_passes") full = value;
+      if (key == "detection_partial_passes") partial = value;
+    }
+    std::printf("surface_refresh %.2f: %ld steps, %.0f full and %.0f partial detections, %ld surface node-steps\n",
+                refresh, steps, full, partial, surface_steps);
+    return std::tuple{std::move(sim), full, partial};
+  };
+  const auto [every, full_every, partial_every] = run(0.0);
+  const auto [settled, full_settled, partial_settled] = run(0.1);
+  EXPECT_EQ(partial_every, 0.0);
+  EXPECT_GT(partial_settled, 2.0 * full_settled) << "most detections skip the settled interior";
+  const auto& a = every->model();
+  const auto& b = settled->model();
+  ASSERT_EQ(a.nodes.size(), b.nodes.size());
+  const auto sa = std::as_const(a.nodes).view(a.fields.stress), sb = std::as_const(b.nodes).view(b.fields.stress);
+  const auto va = std::as_const(a.nodes).view(a.fields.velocity), vb = std::as_const(b.nodes).view(b.fields.velocity);
+  long differ = 0;
+  for (Index i = 0; i < a.nodes.size(); ++i) {
+    const auto iu = static_cast<std::size_t>(i);
+    differ += a.nodes.position[iu] != b.nodes.position[iu] ? 1 : 0;
+    for (int k = 0; k < 4; ++k) differ += sa(i, k) != sb(i, k) ? 1 : 0;
+    for (int k = 0; k < 2; ++k) differ += va(i, k) != vb(i, k) ? 1 : 0;
+  }
+  EXPECT_EQ(differ, 0) << "positions, stresses and velocities bit for bit";
 }
 
 }  // namespace
