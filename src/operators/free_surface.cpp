@@ -187,21 +187,21 @@ void detect_free_surface(const ParticleSet<Dim>& set, const Relation<Dim>& relat
   bool full = true;
   if (options.refresh_displacement > 0.0 && work.settled.size() == nu && work.reference_position.size() == nu &&
       work.reference_volume.size() == nu && lambda.size() == nu && flags.size() == nu && normals.size() == nu) {
-    // One vectorised sweep: any node moved more than refresh_displacement, or whose volume
+    // One sweep on the threads: any node moved more than refresh_displacement, or whose volume
     // changed by more than refresh_volume of its reference (a frozen node, volume 0, counts).
     const double d2 = options.refresh_displacement * options.refresh_displacement, dv = options.refresh_volume;
     const Vec<Dim>* x = set.position.data();
     const Vec<Dim>* x0 = work.reference_position.data();
     const double* v = set.volume.data();
     const double* v0 = work.reference_volume.data();
-    int due = 0;
-#pragma omp simd reduction(| : due)
-    for (std::size_t i = 0; i < nu; ++i) {
-      double moved2 = 0.0;
-      for (int d = 0; d < Dim; ++d) moved2 += (x[i][d] - x0[i][d]) * (x[i][d] - x0[i][d]);
-      due |= static_cast<int>(moved2 > d2) | static_cast<int>(std::abs(v[i] - v0[i]) > dv * v0[i]);
-    }
-    full = due != 0;
+    const auto over = exec::particle_reduce<1>(policy, n, work.reduction, [&](Index i, double* acc) {
+      const auto iu = static_cast<std::size_t>(i);
+      const bool moved = (x[iu] - x0[iu]).squaredNorm() > d2;
+      const bool swelled = std::abs(v[iu] - v0[iu]) > dv * v0[iu];
+      acc[0] += moved || swelled ? 1.0 : 0.0;
+    });
+    const bool due = over[0] > 0.0;
+    full = due;
   }
   work.last_full = full;
   std::vector<Index>& active = work.active;

@@ -54,9 +54,10 @@ struct FreeSurfaceScratch {
   std::vector<Index> active;  // the nodes not settled at the last full pass
   std::vector<Vec<Dim>> reference_position;
   std::vector<double> reference_volume;
-  std::int64_t full_passes = 0;     // calls that evaluated every node
-  std::int64_t partial_passes = 0;  // calls that skipped the settled interior
-  bool last_full = true;            // whether the last call was a full pass
+  exec::ReductionScratch reduction;  // the refresh test's block sums
+  std::int64_t full_passes = 0;      // calls that evaluated every node
+  std::int64_t partial_passes = 0;   // calls that skipped the settled interior
+  bool last_full = true;             // whether the last call was a full pass
   std::size_t bytes() const {
     return lambda.capacity() * sizeof(double) + keep.capacity() + improved.capacity() * sizeof(Vec<Dim>) +
            settled.capacity() + active.capacity() * sizeof(Index) + reference_position.capacity() * sizeof(Vec<Dim>) +

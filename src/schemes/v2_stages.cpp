@@ -257,19 +257,22 @@ void DetectFreeSurface<Dim>::run(const StepContext&) {
   const auto nn = static_cast<std::size_t>(m_.nodes.size());
   // The temporal coherence needs a last step: the first detection runs without it.
   previous_.resize(detections_ > 0 ? nn : 0);
-  for (std::size_t i = 0; i < previous_.size(); ++i) previous_[i] = flag(i, 0) != 0.0 ? 1 : 0;
+  const bool first = previous_.empty();
   ++detections_;
+  const std::vector<std::uint8_t>* touching = nullptr;
   if constexpr (Dim == 2) {
-    if (contact_ != nullptr) {
-      const auto& touching = contact_->in_contact();
-      for (std::size_t i = 0; i < nn; ++i) excluded_[i] = fixed_excluded_[i] | touching[i];
-    }
+    if (contact_ != nullptr) touching = &contact_->in_contact();
   }
-  // Nodes without volume (deactivated outside the domain box, schemes/deactivate_stage.hpp)
-  // are no part of the body: never flagged.
-  for (std::size_t i = 0; i < nn; ++i) {
-    if (m_.nodes.volume[i] == 0.0) excluded_[i] = 1;
-  }
+  // The last flags, and the nodes never flagged: those of the boundary entries, those in contact
+  // with a body, and those without volume (deactivated outside the domain box,
+  // schemes/deactivate_stage.hpp: no part of the body). On the threads: the loops over every
+  // node would otherwise be a serial part of each step.
+  exec::particle_for(m_.policy, static_cast<Index>(nn), [&](Index i) {
+    const auto iu = static_cast<std::size_t>(i);
+    if (!first) previous_[iu] = flag(iu, 0) != 0.0 ? 1 : 0;
+    if (touching != nullptr) excluded_[iu] = fixed_excluded_[iu] | (*touching)[iu];
+    if (m_.nodes.volume[iu] == 0.0) excluded_[iu] = 1;
+  });
   FreeSurfaceOptions options;
   options.refresh_displacement = m_.setup.surface_refresh * m_.dx();
   detect_free_surface<Dim>(m_.nodes, rebuild_.node_neighbours(), m_.kernel, options, previous_, excluded_, flags_,
@@ -301,10 +304,13 @@ void DetectFreeSurface<Dim>::run(const StepContext&) {
       }
     }
   }
+  exec::particle_for(m_.policy, static_cast<Index>(nn), [&](Index i) {
+    const auto iu = static_cast<std::size_t>(i);
+    flag(iu, 0) = flags_[iu];
+    for (int d = 0; d < Dim; ++d) normal(iu, d) = normals_[iu][d];
+  });
   surface_.clear();
   for (std::size_t i = 0; i < nn; ++i) {
-    flag(i, 0) = flags_[i];
-    for (int d = 0; d < Dim; ++d) normal(i, d) = normals_[i][d];
     if (flags_[i] != 0) surface_.push_back(static_cast<Index>(i));
   }
   surface_nodes_ = static_cast<Index>(surface_.size());
