@@ -122,20 +122,26 @@ void RebuildOperators<Dim>::run(const StepContext& c) {
   // Any pair's distance changed by at most the sum of two displacements since the last search.
   // A resumed run measures them from the checkpoint's reference positions, so that it searches
   // (and sorts) at the steps the uninterrupted run does.
-  double moved = 0.0;
+  // Due once some particle has moved half the skin: counted on the threads (a serial sweep over
+  // both sets was a serial part of every step).
   const bool renewed = m_.stress_points.replacements() != stress_point_replacements_at_build_;
   const bool resumed = resumed_;
   resumed_ = false;
   const bool reference = relation_builds_ > 0 || resumed;
+  bool moved_half_skin = false;
   if (reference && !renewed) {
-    for (std::size_t i = 0; i < nodes_at_build_.size(); ++i) {
-      moved = std::max(moved, (m_.nodes.position[i] - nodes_at_build_[i]).squaredNorm());
-    }
-    for (std::size_t i = 0; i < stress_points_at_build_.size(); ++i) {
-      moved = std::max(moved, (m_.stress_points.position[i] - stress_points_at_build_[i]).squaredNorm());
-    }
+    const double half2 = 0.25 * skin_ * skin_;
+    auto count_moved = [&](const std::vector<Vec<Dim>>& now, const std::vector<Vec<Dim>>& then) {
+      return exec::particle_reduce<1>(m_.policy, static_cast<Index>(then.size()), reduction_,
+                                      [&](Index i, double* acc) {
+                                        const auto iu = static_cast<std::size_t>(i);
+                                        acc[0] += (now[iu] - then[iu]).squaredNorm() >= half2 ? 1.0 : 0.0;
+                                      })[0];
+    };
+    moved_half_skin = count_moved(m_.nodes.position, nodes_at_build_) > 0.0 ||
+                      count_moved(m_.stress_points.position, stress_points_at_build_) > 0.0;
   }
-  const bool due = !reference || renewed || 2.0 * std::sqrt(moved) >= skin_;
+  const bool due = !reference || renewed || moved_half_skin;
   // Sorted just before a search, so that the new lists are built on the new order: at every
   // search ("always"), or once the gap measured at the last search has doubled since the last
   // sort ("auto"; the gap of the next lists is not known before the search).

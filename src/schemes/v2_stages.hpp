@@ -103,6 +103,7 @@ class RebuildOperators final : public Stage {
   double gap_ = -1.0, gap_ref_ = -1.0;  // storage gap at the last search and after the last sort
   bool resumed_ = false;  // the Verlet reference came from a checkpoint
   double skin_;
+  exec::ReductionScratch reduction_;  // the Verlet trigger's block sums
   Relation<Dim> to_stress_points_, to_nodes_, constrained_, node_neighbours_;
   std::vector<Vec<Dim>> constrained_positions_;
   std::vector<Vec<Dim>> nodes_at_build_, stress_points_at_build_;
