@@ -254,7 +254,8 @@ struct CaseSetup {
   /// (solver.free_surface = "faces" | "detect").
   bool detect_free_surface = false;
   /// The detection's settled interior (method-notes §3.6): every node is evaluated again once
-  /// some node has moved surface_refresh * dx since the last full pass; 0: every step.
+  /// some node has moved more than surface_refresh * dx (or changed its volume by more than 2 %)
+  /// since the last full pass; 0: every step.
   double surface_refresh = 0.1;
   SourceCoupling coupling = SourceCoupling::additive;
   /// V2: the stress points re-seeded from the node cloud (method-notes §5.2, "Regularisation";
