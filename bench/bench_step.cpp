@@ -240,17 +240,12 @@ void BM_V2Step(benchmark::State& state) {
     return;
   }
   const auto* surface = solver.scheme().find<DetectFreeSurface<2>>();
-  auto surface_seconds = [&] {
-    if (surface == nullptr) return 0.0;
-    for (const auto& [key, value] : surface->report()) {
-      if (key == "detection_seconds") return value;
-    }
-    return 0.0;
-  };
+
   const long searches0 = rebuild->relation_builds();
   const double search0 = rebuild->relation_seconds(), build0 = rebuild->operator_seconds();
   const double sort0 = rebuild->sort_seconds();
   const long sorts0 = rebuild->sorts();
+  // A figure of the detection's report (its seconds, its full passes), 0 without detection.
   auto surface_report = [&](std::string_view name) {
     if (surface == nullptr) return 0.0;
     for (const auto& [key, value] : surface->report()) {
@@ -258,7 +253,7 @@ void BM_V2Step(benchmark::State& state) {
     }
     return 0.0;
   };
-  const double surface0 = surface_seconds();
+  const double surface0 = surface_report("detection_seconds");
   const double full_passes0 = surface_report("detection_full_passes");
   const auto t0 = std::chrono::steady_clock::now();
   for (auto _ : state) {
@@ -273,7 +268,7 @@ void BM_V2Step(benchmark::State& state) {
   state.counters["searches/step"] = static_cast<double>(rebuild->relation_builds() - searches0) / steps;
   state.counters["search_share"] = (rebuild->relation_seconds() - search0) / seconds;
   state.counters["operator_share"] = (rebuild->operator_seconds() - build0) / seconds;
-  state.counters["surface_share"] = (surface_seconds() - surface0) / seconds;
+  state.counters["surface_share"] = (surface_report("detection_seconds") - surface0) / seconds;
   state.counters["full_surface_passes/step"] = (surface_report("detection_full_passes") - full_passes0) / steps;
   state.counters["sort_share"] = (rebuild->sort_seconds() - sort0) / seconds;
   state.counters["sorts/step"] = static_cast<double>(rebuild->sorts() - sorts0) / steps;

@@ -63,11 +63,19 @@ class CubicSplineKernel {
     const double t = 2.0 - q;
     const double w_inner = alpha * (2.0 / 3.0 - q * q + 0.5 * q * q * q);
     const double w_outer = alpha * (1.0 / 6.0) * t * t * t;
-    const double d_inner = alpha * inv_h * (-2.0 + 1.5 * q);
-    const double d_outer = -0.5 * alpha * inv_h * t * t / std::max(q, 1.0);
-    const bool inner = q < 1.0;
-    w = inner ? w_inner : w_outer;
-    h_dw_over_r = inner ? d_inner : d_outer;
+    w = q < 1.0 ? w_inner : w_outer;
+    h_dw_over_r = scaled_derivative<double>(r, inv_h, alpha);
+  }
+
+  /// h W'(r)/r alone, as above, in double or float (the free surface's single-precision
+  /// pre-screen, method-notes §3.6).
+  template <class Real>
+  static Real scaled_derivative(Real r, Real inv_h, Real alpha) {
+    const Real q = r * inv_h;
+    const Real t = Real(2) - q;
+    const Real d_inner = alpha * inv_h * (Real(-2) + Real(1.5) * q);
+    const Real d_outer = Real(-0.5) * alpha * inv_h * t * t / std::max(q, Real(1));
+    return q < Real(1) ? d_inner : d_outer;
   }
   double inv_h() const { return inv_h_; }
   double alpha() const { return alpha_; }

@@ -29,6 +29,32 @@ double smallest_eigenvalue(const Mat<Dim>& B) {
   }
 }
 
+// The candidates of node I inside the support, as x_I - x_J, |x_I - x_J|^2 and V_J in arrays of
+// Real (structure of arrays), by a branch-free compaction; the arrays have room for row.size() +
+// pad entries. Returns how many are inside.
+template <int Dim, class Real>
+std::size_t gather_support(std::span<const Index> row, const Vec<Dim>& xi, const ParticleSet<Dim>& set, double r2,
+                           std::size_t pad, std::vector<Real> (&x)[Dim], std::vector<Real>& d2,
+                           std::vector<Real>& volume) {
+  const std::size_t m = row.size() + pad;
+  if (d2.size() < m) {
+    for (auto& v : x) v.resize(m);
+    d2.resize(m);
+    volume.resize(m);
+  }
+  std::size_t count = 0;
+  for (const Index j : row) {
+    const auto ju = static_cast<std::size_t>(j);
+    const Vec<Dim> x_ij = xi - set.position[ju];
+    const double s = x_ij.squaredNorm();
+    for (int d = 0; d < Dim; ++d) x[d][count] = static_cast<Real>(x_ij[d]);
+    d2[count] = static_cast<Real>(s);
+    volume[count] = static_cast<Real>(set.volume[ju]);
+    count += s < r2 ? 1 : 0;
+  }
+  return count;
+}
+
 // The pairs of one node in arrays (structure of arrays), kept per thread between calls.
 template <int Dim>
 struct PairArrays {
@@ -39,23 +65,8 @@ struct PairArrays {
   std::size_t n = 0;
 
   void gather(std::span<const Index> row, const Vec<Dim>& xi, const ParticleSet<Dim>& set, double r2) {
-    if (d2.size() < row.size()) {
-      for (auto& v : x) v.resize(row.size());
-      d2.resize(row.size());
-      volume.resize(row.size());
-      factor.resize(row.size());
-    }
-    std::size_t count = 0;
-    for (const Index j : row) {
-      const auto ju = static_cast<std::size_t>(j);
-      const Vec<Dim> x_ij = xi - set.position[ju];
-      const double s = x_ij.squaredNorm();
-      for (int d = 0; d < Dim; ++d) x[d][count] = x_ij[d];
-      d2[count] = s;
-      volume[count] = set.volume[ju];
-      count += s < r2 ? 1 : 0;
-    }
-    n = count;
+    n = gather_support<Dim, double>(row, xi, set, r2, 0, x, d2, volume);
+    if (factor.size() < d2.size()) factor.resize(d2.size());
   }
 
   // B = sum_J V_J (x_J - x_I) (x) grad_I W_IJ (symmetric: grad_I W_IJ = W'/r x_IJ) and
@@ -106,30 +117,14 @@ struct ScreenArrays {
   // Returns the smallest eigenvalue of B (the symmetric B of PairArrays::moments).
   double lambda(std::span<const Index> row, const Vec<Dim>& xi, const ParticleSet<Dim>& set, double r2, double inv_h,
                 double alpha) {
-    const std::size_t m = row.size() + kLanes;
-    if (d2.size() < m) {
-      for (auto& v : x) v.resize(m);
-      d2.resize(m);
-      volume.resize(m);
-    }
-    std::size_t count = 0;
-    for (const Index j : row) {
-      const auto ju = static_cast<std::size_t>(j);
-      const Vec<Dim> x_ij = xi - set.position[ju];
-      const double s = x_ij.squaredNorm();
-      for (int d = 0; d < Dim; ++d) x[d][count] = static_cast<float>(x_ij[d]);
-      d2[count] = static_cast<float>(s);
-      volume[count] = static_cast<float>(set.volume[ju]);
-      count += s < r2 ? 1 : 0;
-    }
+    const std::size_t count = gather_support<Dim, float>(row, xi, set, r2, kLanes, x, d2, volume);
     const std::size_t padded = (count + kLanes - 1) / kLanes * kLanes;
     for (std::size_t k = count; k < padded; ++k) {
       for (int d = 0; d < Dim; ++d) x[d][k] = 0.0f;
       d2[k] = 0.0f;
       volume[k] = 0.0f;  // no volume: no contribution
     }
-    // h W'(r)/r of the cubic spline (CubicSplineKernel::value_and_scaled_derivative) times inv_h.
-    const float a = static_cast<float>(alpha * inv_h * inv_h), ih = static_cast<float>(inv_h);
+    const float ih = static_cast<float>(inv_h), al = static_cast<float>(alpha);
     // The Dim (Dim + 1) / 2 entries of the symmetric B, row by row.
     constexpr int kEntries = Dim * (Dim + 1) / 2;
     constexpr std::array<int, 6> kRow =
@@ -145,11 +140,8 @@ struct ScreenArrays {
 #pragma omp simd
       for (std::size_t l = 0; l < kLanes; ++l) {
         const std::size_t k = k0 + l;
-        const float q = std::sqrt(s2[k]) * ih;
-        const float t = 2.0f - q;
-        const float inner = a * (-2.0f + 1.5f * q);
-        const float outer = -0.5f * a * t * t / std::max(q, 1.0f);
-        const float f = V[k] * (q < 1.0f ? inner : outer);
+        // V_J W'(r)/r = V_J (h W'/r) / h.
+        const float f = V[k] * CubicSplineKernel<Dim>::template scaled_derivative<float>(std::sqrt(s2[k]), ih, al) * ih;
         for (int c = 0; c < kEntries; ++c) sb[c][l] += f * xs[kRow[c]][k] * xs[kCol[c]][k];
       }
     }
