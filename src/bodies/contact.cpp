@@ -73,6 +73,8 @@ RigidContact::RigidContact(const std::vector<BodySpec>& specs, std::size_t nodes
   release_snn_.assign(kMaxContacts * nodes, 0.0);
   x_begin_.assign(nodes, Vec<2>::Zero());
   along_.reserve(nodes);
+  ends_.reserve(16);
+  corner_reach_ = 2.4 * dx;  // the support at the default h = 1.2 dx
 }
 
 void RigidContact::advance_bodies(double t, double dt, double damping) {
@@ -307,6 +309,7 @@ void RigidContact::end_step(double dt, std::vector<Vec<2>>& x, FieldView<double,
       ++state_[b].node_projections;
     }
   }
+  free_corners(x, s);
   for (auto& xe : stress_point_x) {
     for (std::size_t b = 0; b < bodies_.size(); ++b) {
       const BodyGap gap = bodies_[b].gap(xe, state_[b].offset, depth_);
@@ -322,6 +325,68 @@ void RigidContact::end_step(double dt, std::vector<Vec<2>>& x, FieldView<double,
     const double p = state_[b].force.dot(state_[b].velocity);
     state_[b].work += 0.5 * dt * (last_power_[b] + p);
     last_power_[b] = p;
+  }
+}
+
+void RigidContact::sort_along(std::size_t b, const std::vector<Vec<2>>& x) {
+  along_.clear();
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    if (in_contact_[i] == 0) continue;
+    for (int k = 0; k < kMaxContacts; ++k) {
+      const std::size_t slot = kMaxContacts * i + static_cast<std::size_t>(k);
+      if (body_[slot] != static_cast<int>(b)) continue;
+      const BodyGap gap = bodies_[b].gap(x[i], state_[b].offset, depth_);
+      if (gap.within) along_.emplace_back(gap.s, slot);
+    }
+  }
+  std::sort(along_.begin(), along_.end());
+}
+
+void RigidContact::free_corners(const std::vector<Vec<2>>& x, FieldView<double, NS> s) {
+  // A free corner (method-notes §4.5, eq. (4.5.8)): a contact node at the end of its patch along
+  // the body where the soil ends, so that a free face of the soil meets the body there. That
+  // face's normal traction vanishes; on a face across the body (normal +-t) it is sigma_tt, which
+  // no contact law sets, and which the node otherwise keeps from step 2. Left free, it let a block
+  // dragged over a Coulomb base carry 16 % more shear than the friction limit, through the
+  // compression that the overturning moment puts at the leading corner (docs/VALIDATION.md,
+  // "Rigid bodies"). sigma_nn and sigma_nt stay the contact's. Not a corner: a node on two bodies
+  // (the face beyond is the other body's), a node with a lattice condition (a symmetry plane), a
+  // patch end with soil past it within the kernel's support (a footing's edge on a wider
+  // surface, or the soil heaved up beside a footing that has sunk into it).
+  ends_.clear();
+  const std::size_t nn = x.size();
+  for (std::size_t b = 0; b < bodies_.size(); ++b) {
+    sort_along(b, x);
+    state_[b].free_corners = 0;
+    for (std::size_t j = 0; j < along_.size(); ++j) {
+      const std::size_t slot = along_[j].second;
+      const std::size_t i = slot / kMaxContacts;
+      if (body_[kMaxContacts * i] >= 0 && body_[kMaxContacts * i + 1] >= 0) continue;
+      if (has_prescribed_ && has_prescribed_(static_cast<Index>(i))) continue;
+      const Vec<2> t = body_tangent(normal_[slot]);
+      if (j == 0 || along_[j].first - along_[j - 1].first > adjacent_) ends_.push_back({slot, -t, false});
+      if (j + 1 == along_.size() || along_[j + 1].first - along_[j].first > adjacent_)
+        ends_.push_back({slot, t, false});
+    }
+  }
+  if (ends_.empty()) return;
+  const double past = 0.5 * dx_, reach2 = corner_reach_ * corner_reach_;
+  for (std::size_t k = 0; k < nn; ++k) {
+    for (PatchEnd& e : ends_) {
+      const Vec<2> r = x[k] - x[e.slot / kMaxContacts];
+      if (r.dot(e.out) > past && r.squaredNorm() < reach2) e.beyond = true;
+    }
+  }
+  for (const PatchEnd& e : ends_) {
+    if (e.beyond) continue;
+    double* si = s[static_cast<Index>(e.slot / kMaxContacts)];
+    const Vec<2>& t = e.out;
+    const double stt = t[0] * t[0] * si[0] + t[1] * t[1] * si[1] + 2.0 * t[0] * t[1] * si[3];
+    // sigma -= sigma_tt t (x) t: sigma_nn and sigma_nt are unchanged (n . t = 0).
+    si[0] -= stt * t[0] * t[0];
+    si[1] -= stt * t[1] * t[1];
+    si[3] -= stt * t[0] * t[1];
+    ++state_[static_cast<std::size_t>(body_[e.slot])].free_corners;
   }
 }
 
@@ -361,16 +426,7 @@ void RigidContact::measure(const std::vector<Vec<2>>& x, ConstFieldView<double, 
         }
       }
     }
-    along_.clear();
-    for (std::size_t i = 0; i < x.size(); ++i) {
-      if (in_contact_[i] == 0) continue;
-      for (int k = 0; k < kMaxContacts; ++k) {
-        if (body_[kMaxContacts * i + static_cast<std::size_t>(k)] != static_cast<int>(b)) continue;
-        const BodyGap gap = bodies_[b].gap(x[i], state_[b].offset, depth_);
-        if (gap.within) along_.emplace_back(gap.s, kMaxContacts * i + static_cast<std::size_t>(k));
-      }
-    }
-    std::sort(along_.begin(), along_.end());
+    sort_along(b, x);
     Vec<2> force = Vec<2>::Zero();
     double width = 0.0, power = 0.0;
     const double s0 = bodies_[b].s_begin(), s1 = bodies_[b].s_end();

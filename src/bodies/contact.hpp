@@ -10,7 +10,8 @@
 //   end_step (state at t^{n+1}, after step 2): the constraints on the contact nodes
 //     (v_n = V.n; tangential by the law, with Coulomb's stick/slip decided explicitly on the
 //     trial stress), the positions and displacements moved with the body, the stress
-//     conditions (smooth: sigma_nt = 0; Coulomb slip: sigma_nt = sgn(dv_t) tau_max), then any
+//     conditions (smooth: sigma_nt = 0; Coulomb slip: sigma_nt = sgn(dv_t) tau_max; at a free
+//     corner, the end of a patch where the soil ends, sigma_tt = 0), then any
 //     other node or stress point that crossed a body projected back onto it (counted), and the
 //     reaction of each body F = sum_I sigma_I n A_I with the tributary lengths A_I.
 // Every array is sized at construction: the steps allocate nothing.
@@ -37,6 +38,7 @@ struct BodyState {
   long contact_nodes = 0;
   long node_projections = 0;  // nodes that crossed the body and were put back on it (total)
   long stress_point_projections = 0;
+  long free_corners = 0;  // contact nodes where a free face of the soil meets the body (last step)
   double work = 0.0;     // J/m: the work of the reaction on the body, int F.V dt
   double min_gap = 0.0;  // m: the smallest signed distance of a node before projection (last step)
 };
@@ -78,6 +80,14 @@ class RigidContact {
   /// reaction.
   void end_step(double dt, std::vector<Vec<2>>& x, FieldView<double, 2> v, FieldView<double, NS> s,
                 FieldView<double, 2> u, std::vector<Vec<2>>& stress_point_x);
+  /// What decides a free corner (method-notes eq. (4.5.8)): the kernel's support radius, within
+  /// which a node past a patch's end means that the soil goes on (2.4 dx until set), and which
+  /// nodes carry a prescribed component of their own (a lattice condition such as a symmetry
+  /// roller), where the end of a patch is not a free corner (none until set).
+  void set_free_corner_rule(double support_radius, std::function<bool(Index)> has_prescribed) {
+    corner_reach_ = support_radius;
+    has_prescribed_ = std::move(has_prescribed);
+  }
   /// The contact set and the reaction at the current state without advancing (t = 0, output).
   void select_now(double t, const std::vector<Vec<2>>& x, ConstFieldView<double, 2> v, ConstFieldView<double, NS> s);
   bool selected() const { return selected_; }
@@ -118,6 +128,9 @@ class RigidContact {
   void drive_bodies(double dt, const std::vector<Vec<2>>& x, ConstFieldView<double, 2> v, ConstFieldView<double, NS> s);
   void select(const std::vector<Vec<2>>& x, ConstFieldView<double, 2> v, ConstFieldView<double, NS> s);
   void measure(const std::vector<Vec<2>>& x, ConstFieldView<double, 2> v, ConstFieldView<double, NS> s);
+  /// along_ <- body b's contact slots within its extent, sorted by their position s along it.
+  void sort_along(std::size_t b, const std::vector<Vec<2>>& x);
+  void free_corners(const std::vector<Vec<2>>& x, FieldView<double, NS> s);
 
   std::vector<RigidBody> bodies_;
   std::vector<BodyState> state_;
@@ -135,6 +148,14 @@ class RigidContact {
   std::vector<Vec<2>> x_begin_;      // positions at t^n (contact nodes only are read)
   std::vector<std::pair<double, std::size_t>> along_;  // (s, node) of one body's contact nodes
   std::vector<ContactPoint> profile_;                  // every body's contact nodes, last measure
+  struct PatchEnd {
+    std::size_t slot;
+    Vec<2> out;   // along the body, away from the patch
+    bool beyond;  // a node of the soil lies past it
+  };
+  std::vector<PatchEnd> ends_;  // single-contact patch ends, current step
+  double corner_reach_;
+  std::function<bool(Index)> has_prescribed_;
   std::vector<double> last_power_;                     // per body, F.V at the last measure
   double power_ = 0.0;
   bool selected_ = false;

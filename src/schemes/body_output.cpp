@@ -25,6 +25,7 @@ void add_body_report(const std::string& name, const BodyState& st, std::vector<s
   out.emplace_back(name + ".contact_nodes", static_cast<double>(st.contact_nodes));
   out.emplace_back(name + ".node_projections", static_cast<double>(st.node_projections));
   out.emplace_back(name + ".stress_point_projections", static_cast<double>(st.stress_point_projections));
+  out.emplace_back(name + ".free_corners", static_cast<double>(st.free_corners));
   out.emplace_back(name + ".displacement_x", st.offset[0]);
   out.emplace_back(name + ".displacement_y", st.offset[1]);
   out.emplace_back(name + ".work", st.work);

@@ -204,7 +204,12 @@ class ContactSelect final : public Stage {
 class ContactEnforce final : public Stage, public BodyOutput {
  public:
   ContactEnforce(StaggeredModel<2>& model, std::shared_ptr<RigidContact> contact)
-      : m_(model), contact_(std::move(contact)) {}
+      : m_(model), contact_(std::move(contact)) {
+    // Soil within a node's support past its patch's end, or a lattice condition on it (a
+    // symmetry roller): no free corner there (method-notes eq. (4.5.8)).
+    contact_->set_free_corner_rule(m_.kernel.support_radius(),
+                                   [&c = m_.constraints](Index i) { return c.begin(i) != c.end(i); });
+  }
   std::string_view name() const override { return "contact_enforce"; }
   void run(const StepContext& context) override;
   std::size_t scratch_bytes() const override;

@@ -140,7 +140,18 @@ CaseReport validate_case10(const Options& opt, const std::string& dir) {
 
   rep.metrics.push_back(outcome_metric(tag + "N = 3.4 classified stable", st.run, CutOutcome::stable));
   rep.metrics.push_back(metric(tag + "N = 3.4: largest displacement at the end / H", st.max_disp / kH, "<=", 0.01, ""));
-  rep.metrics.push_back(outcome_metric(tag + "N = 4.5 classified collapse", fl.run, CutOutcome::collapse));
+  {
+    Metric m = outcome_metric(tag + "N = 4.5 classified collapse", fl.run, CutOutcome::collapse);
+    // A run that the growth guard stops before the crest has moved 0.05 H is not classified: the
+    // instability at the slide's front (below) is the miss, and it is reported there too.
+    if (!m.pass() && !fl.run.error.empty()) {
+      m.known_deviation = fmt::format(
+          "open: not classified, the run goes unstable at t = {:.2f} s (u_c = {:.2f} m) at the slide's front, before "
+          "the crest has moved 0.05 H; whether the front survives is sensitive to the step (docs/VALIDATION.md Case 10)",
+          fl.run.t.empty() ? 0.0 : fl.run.t.back(), fl.run.uc.empty() ? 0.0 : fl.run.uc.back());
+    }
+    rep.metrics.push_back(m);
+  }
   rep.metrics.push_back(metric(tag + "N = 4.5: main scarp behind the original crest at the end, >= 0.7 H",
                                fl.scarp_end, ">=", 0.7 * kH, "m"));
   rep.metrics.push_back(metric(tag + "N = 4.5: main scarp behind the original crest at the end, <= 1.15 H",
@@ -169,14 +180,25 @@ CaseReport validate_case10(const Options& opt, const std::string& dir) {
       Metric m = metric(tag + label + ": time the kinetic energy first falls to 1e-4 of its peak (<= 20 s)",
                         std::isfinite(res.t_settled) ? res.t_settled : 1e9, "<=", 20.0 + 1e-6, "s");
       if (!m.pass()) {
-        m.known_deviation =
-            !run.error.empty()
-                ? unstable
-                : fmt::format("open: the cut stands, but after the damping stops (t = 5 s) it keeps an elastic vibration "
-                              "of {:.2g} of the peak kinetic energy at 20 s: below yield nothing dissipates it but the "
-                              "simple scheme's diffusion; reaching 1e-4 needs the damping on beyond the ramp, which "
-                              "docs/cases.md Case 5 does not allow",
-                              res.ke_end_ratio);
+        const std::size_t n = run.uc.size();
+        std::size_t from = n;  // the first record of the last second
+        while (from > 0 && !run.t.empty() && run.t[from - 1] >= run.t.back() - 1.0) --from;
+        const double creep = n > 0 && from < n ? run.uc.back() - run.uc[from] : 0.0;
+        if (!run.error.empty()) {
+          m.known_deviation = unstable;
+        } else if (label == "N = 3.4") {
+          m.known_deviation = fmt::format(
+              "open: the cut stands, but after the damping stops (t = 5 s) it keeps an elastic vibration of {:.2g} of "
+              "the peak kinetic energy at 20 s: below yield nothing dissipates it but the simple scheme's diffusion; "
+              "reaching 1e-4 needs the damping on beyond the ramp, which docs/cases.md Case 5 does not allow",
+              res.ke_end_ratio);
+        } else {
+          m.known_deviation = fmt::format(
+              "open: the slide has not come to rest by 20 s: {:.2g} of the peak kinetic energy, u_c still moving "
+              "{:.2g} m in the last second, the deposit in front of the toe creeping over the rough base "
+              "(docs/VALIDATION.md Case 10)",
+              res.ke_end_ratio, creep);
+        }
       }
       rep.metrics.push_back(m);
     }
