@@ -39,8 +39,8 @@ struct BodyState {
   long node_projections = 0;  // nodes that crossed the body and were put back on it (total)
   long stress_point_projections = 0;
   long free_corners = 0;  // contact nodes where a free face of the soil meets the body (last step)
-  double work = 0.0;     // J/m: the work of the reaction on the body, int F.V dt
-  double min_gap = 0.0;  // m: the smallest signed distance of a node before projection (last step)
+  double work = 0.0;      // J/m: the work of the reaction on the body, int F.V dt
+  double min_gap = 0.0;   // m: the smallest signed distance of a node before projection (last step)
 };
 
 /// One contact node of a body at the last measure (the contact pressure profile, contact.csv).
@@ -154,9 +154,9 @@ class RigidContact {
     bool beyond;  // a node of the soil lies past it
   };
   std::vector<PatchEnd> ends_;  // single-contact patch ends, current step
-  double corner_reach_;
+  double corner_reach_ = 0.0;   // m, set by the constructor and set_free_corner_rule
   std::function<bool(Index)> has_prescribed_;
-  std::vector<double> last_power_;                     // per body, F.V at the last measure
+  std::vector<double> last_power_;  // per body, F.V at the last measure
   double power_ = 0.0;
   bool selected_ = false;
 };

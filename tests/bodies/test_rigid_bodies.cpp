@@ -446,7 +446,7 @@ namespace {
 // pulled 16 % more than the base resisted.
 TEST(RigidBodies, BlockDraggedOverACoulombBaseSlidesAtTheFrictionLimit) {
   const test::ThreadCount threads(1);
-  const double load = 1.0e4, mu = 0.3, adhesion = 500.0;  // N/m, -, Pa
+  const double load = 1.0e4, mu = 0.3, adhesion = 500.0;                      // N/m, -, Pa
   const double damping = 10.0, speed = 0.005, block_mass = kRho * 1.0 * 0.2;  // 1/s, m/s, kg/m
   CaseBuilder<2> b("block dragged over a Coulomb base");
   b.spacing(0.05)
