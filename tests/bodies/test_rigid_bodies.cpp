@@ -443,7 +443,7 @@ namespace {
 // sliding block, c_d rho W H V, is added to the limit. Before the free corners of method-notes
 // eq. (4.5.8), the corner nodes kept the sigma_xx that the overturning moment puts there
 // (-30 kPa at the leading one), a lateral force that no face of the block can carry: the plate
-// pulled 16 % more than the base resisted.
+// pulled 16 % more than mu P + a W.
 TEST(RigidBodies, BlockDraggedOverACoulombBaseSlidesAtTheFrictionLimit) {
   const test::ThreadCount threads(1);
   const double load = 1.0e4, mu = 0.3, adhesion = 500.0;                      // N/m, -, Pa
