@@ -240,7 +240,6 @@ void BM_V2Step(benchmark::State& state) {
     return;
   }
   const auto* surface = solver.scheme().find<DetectFreeSurface<2>>();
-
   const long searches0 = rebuild->relation_builds();
   const double search0 = rebuild->relation_seconds(), build0 = rebuild->operator_seconds();
   const double sort0 = rebuild->sort_seconds();

@@ -309,7 +309,6 @@ void RigidContact::end_step(double dt, std::vector<Vec<2>>& x, FieldView<double,
       ++state_[b].node_projections;
     }
   }
-  free_corners(x, s);
   for (auto& xe : stress_point_x) {
     for (std::size_t b = 0; b < bodies_.size(); ++b) {
       const BodyGap gap = bodies_[b].gap(xe, state_[b].offset, depth_);
@@ -321,6 +320,8 @@ void RigidContact::end_step(double dt, std::vector<Vec<2>>& x, FieldView<double,
   const auto cv = ConstFieldView<double, 2>(v.data(), v.size(), 2);
   const auto cs = ConstFieldView<double, NS>(s.data(), s.size(), NS);
   measure(x, cv, cs);
+  // After the reaction, which sigma_tt does not enter (sigma n); measure() found the patch ends.
+  free_corners(x, s);
   for (std::size_t b = 0; b < bodies_.size(); ++b) {
     const double p = state_[b].force.dot(state_[b].velocity);
     state_[b].work += 0.5 * dt * (last_power_[b] + p);
@@ -349,26 +350,13 @@ void RigidContact::free_corners(const std::vector<Vec<2>>& x, FieldView<double, 
   // no contact law sets, and which the node otherwise keeps from step 2. Left free, it let a block
   // dragged over a Coulomb base carry 16 % more shear than the friction limit, through the
   // compression that the overturning moment puts at the leading corner (docs/VALIDATION.md,
-  // "Rigid bodies"). sigma_nn and sigma_nt stay the contact's. Not a corner: a node on two bodies
-  // (the face beyond is the other body's), a node with a lattice condition (a symmetry plane), a
-  // patch end with soil past it within the kernel's support (a footing's edge on a wider
-  // surface, or the soil heaved up beside a footing that has sunk into it).
-  ends_.clear();
+  // "Rigid bodies"). sigma_nn and sigma_nt stay the contact's. The candidates are the patch ends
+  // that measure() found, except a node on two bodies (the face beyond is the other body's) or
+  // with a lattice condition (a symmetry plane); not a corner either: a patch end with soil past
+  // it within the kernel's support (a footing's edge on a wider surface, or the soil heaved up
+  // beside a footing that has sunk into it).
+  for (BodyState& st : state_) st.free_corners = 0;
   const std::size_t nn = x.size();
-  for (std::size_t b = 0; b < bodies_.size(); ++b) {
-    sort_along(b, x);
-    state_[b].free_corners = 0;
-    for (std::size_t j = 0; j < along_.size(); ++j) {
-      const std::size_t slot = along_[j].second;
-      const std::size_t i = slot / kMaxContacts;
-      if (body_[kMaxContacts * i] >= 0 && body_[kMaxContacts * i + 1] >= 0) continue;
-      if (has_prescribed_ && has_prescribed_(static_cast<Index>(i))) continue;
-      const Vec<2> t = body_tangent(normal_[slot]);
-      if (j == 0 || along_[j].first - along_[j - 1].first > adjacent_) ends_.push_back({slot, -t, false});
-      if (j + 1 == along_.size() || along_[j + 1].first - along_[j].first > adjacent_)
-        ends_.push_back({slot, t, false});
-    }
-  }
   if (ends_.empty()) return;
   const double past = 0.5 * dx_, reach2 = corner_reach_ * corner_reach_;
   for (std::size_t k = 0; k < nn; ++k) {
@@ -404,6 +392,7 @@ void RigidContact::measure(const std::vector<Vec<2>>& x, ConstFieldView<double, 
   // off its edge; docs/VALIDATION.md Case 12).
   power_ = 0.0;
   profile_.clear();
+  ends_.clear();
   std::array<bool, 2> beyond{false, false};
   auto edge = [&](double d, std::size_t end) {
     return d >= 0.0 && (d < dx_ || (beyond[end] && d < adjacent_)) ? d : 0.0;
@@ -443,6 +432,15 @@ void RigidContact::measure(const std::vector<Vec<2>>& x, ConstFieldView<double, 
       const std::size_t slot = along_[j].second;
       const auto i = static_cast<Index>(slot / kMaxContacts);
       const Vec<2> t = node_traction(j);
+      // A patch end: a candidate free corner (free_corners()) unless on two bodies or held by a
+      // lattice condition.
+      const std::size_t iu = slot / kMaxContacts;
+      if ((!has_left || !has_right) && (body_[kMaxContacts * iu] < 0 || body_[kMaxContacts * iu + 1] < 0) &&
+          !(has_prescribed_ && has_prescribed_(i))) {
+        const Vec<2> along = body_tangent(normal_[slot]);
+        if (!has_left) ends_.push_back({slot, -along, false});
+        if (!has_right) ends_.push_back({slot, along, false});
+      }
       Vec<2> f = ((has_left ? left : 0.0) + (has_right ? right : 0.0)) * t;
       // An end length: the mean traction of this node and its neighbour in the patch (if any).
       if (!has_left && left > 0.0) f += left * (has_right ? 0.5 * (t + node_traction(j + 1)) : t);

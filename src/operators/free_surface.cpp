@@ -192,8 +192,7 @@ void detect_free_surface(const ParticleSet<Dim>& set, const Relation<Dim>& relat
       const bool swelled = std::abs(v[iu] - v0[iu]) > dv * v0[iu];
       acc[0] += moved || swelled ? 1.0 : 0.0;
     });
-    const bool due = over[0] > 0.0;
-    full = due;
+    full = over[0] > 0.0;
   }
   work.last_full = full;
   std::vector<Index>& active = work.active;
