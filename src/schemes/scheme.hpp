@@ -58,6 +58,9 @@ class Scheme {
   /// Power of loads outside the particle sets on the body, W (V2: the rigid bodies' contact
   /// tractions), added to the boundary power of the energy account. Empty: none.
   std::function<double()> extra_power;
+  /// Kinetic energy of velocity components prescribed outside the lattice constraints, J (V2:
+  /// the contact nodes' components the bodies set), for the growth guard. Empty: none.
+  std::function<double()> extra_imposed_kinetic;
   /// A hint appended to the growth guard's message (V3: the undrained Courant limit). Empty: none.
   std::function<std::string()> instability_hint;
 

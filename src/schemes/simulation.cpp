@@ -78,7 +78,10 @@ void Simulation<Dim>::step() {
         "material parameters",
         clock_.steps() + 1, t + clock_.dt(), bad, fmt::join(x.data(), x.data() + Dim, ", "), clock_.courant()));
   }
-  clock_.end_step(sums, external_power(), scheme_->instability_hint ? scheme_->instability_hint() : std::string());
+  const double imposed =
+      model_->imposed_kinetic() + (scheme_->extra_imposed_kinetic ? scheme_->extra_imposed_kinetic() : 0.0);
+  clock_.end_step(sums, external_power(), imposed,
+                  scheme_->instability_hint ? scheme_->instability_hint() : std::string());
 }
 
 template <int Dim>

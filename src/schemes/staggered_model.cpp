@@ -341,6 +341,19 @@ double StaggeredModel<Dim>::boundary_power() const {
 }
 
 template <int Dim>
+double StaggeredModel<Dim>::imposed_kinetic() const {
+  const auto v = nodes.view(fields.velocity);
+  double energy = 0.0;
+  for (const Index i : constraints.constrained()) {
+    for (Index k = constraints.begin(i); k < constraints.end(i); ++k) {
+      const int axis = constraints[k].component;
+      if (axis < Dim) energy += 0.5 * nodes.mass(i) * v(i, axis) * v(i, axis);
+    }
+  }
+  return energy;
+}
+
+template <int Dim>
 void StaggeredModel<Dim>::set_initial_state() {
   const auto nn = nodes.size();
   const int vertical = Dim - 1;  // the last axis points up

@@ -133,6 +133,10 @@ class StaggeredModel {
   /// Power of the surface tractions on the body, W (per unit thickness in 2D): the sum over
   /// face nodes of A (sigma . n) . v, with the total stress.
   double boundary_power() const;
+  /// Kinetic energy of the prescribed velocity components, J (per unit thickness in 2D):
+  /// sum over constrained nodes of m v_k^2 / 2 for each prescribed axis k. The boundary imposes
+  /// it before any work is done (a kinematic load starting from rest); the growth guard counts it.
+  double imposed_kinetic() const;
 
   /// The fastest P-wave over both particle sets at their current densities, m/s:
   /// max c_m (rho_m / rho_i)^(1/2) (method-notes eq. (4.3.3); particles without volume, frozen

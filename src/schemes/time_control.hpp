@@ -72,14 +72,17 @@ class TimeControl {
   void set_initial_energy(double energy) { initial_energy_ = energy; }
   /// After the stages of a step: account the energies, update the damping switch, check the
   /// growth guard (throws SolverError with `hint` appended) and advance the clock.
-  void end_step(const StepSums<Dim>& sums, double boundary_power, const std::string& hint);
+  /// `imposed_kinetic` is the kinetic energy of the prescribed velocity components, which the
+  /// guard's budget includes.
+  void end_step(const StepSums<Dim>& sums, double boundary_power, double imposed_kinetic, const std::string& hint);
 
   /// Checkpoints: every value the clock carries (the step length is the case's).
   void save(io::StateArchive& archive) const;
   void load(const io::StateArchive& archive);
 
   /// The kinetic energy of a stable run cannot exceed this multiple of the work done on the
-  /// body plus its initial energy (the materials only dissipate).
+  /// body plus its initial energy plus the kinetic energy its prescribed velocities impose (the
+  /// materials only dissipate).
   static constexpr double kEnergyGrowthLimit = 100.0;
 
  private:
