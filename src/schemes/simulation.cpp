@@ -1,6 +1,8 @@
 #include "schemes/simulation.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -80,8 +82,48 @@ void Simulation<Dim>::step() {
   }
   const double imposed =
       model_->imposed_kinetic() + (scheme_->extra_imposed_kinetic ? scheme_->extra_imposed_kinetic() : 0.0);
-  clock_.end_step(sums, external_power(), imposed,
-                  scheme_->instability_hint ? scheme_->instability_hint() : std::string());
+  clock_.end_step(sums, external_power(), imposed, [this] {
+    return (scheme_->instability_hint ? scheme_->instability_hint() : std::string()) + fastest_node();
+  });
+}
+
+template <int Dim>
+std::string Simulation<Dim>::fastest_node() const {
+  const ParticleSet<Dim>& nodes = model_->nodes;
+  const auto v = nodes.view(model_->fields.velocity);
+  Index fastest = -1;
+  double speed2 = -1.0;
+  for (Index i = 0; i < nodes.size(); ++i) {
+    double s2 = 0.0;
+    for (int d = 0; d < Dim; ++d) s2 += v(i, d) * v(i, d);
+    if (s2 > speed2) speed2 = s2, fastest = i;
+  }
+  if (fastest < 0) return {};
+  const Vec<Dim>& x = nodes.position[static_cast<std::size_t>(fastest)];
+  const double support = 2.0 * model_->kernel.h(), dx = model_->dx();
+  long near_nodes = 0, near_points = 0;
+  double nearest = std::numeric_limits<double>::infinity();
+  for (Index j = 0; j < nodes.size(); ++j) {
+    if (j == fastest) continue;
+    const double r = (nodes.position[static_cast<std::size_t>(j)] - x).norm();
+    nearest = std::min(nearest, r);
+    near_nodes += r < support ? 1 : 0;
+  }
+  for (const Vec<Dim>& xe : model_->stress_points.position) near_points += (xe - x).norm() < support ? 1 : 0;
+  // Where it came from: a node that the growth has thrown clear of the body is named by its place
+  // in the body as made (x - u).
+  const auto u = nodes.view(model_->fields.displacement);
+  Vec<Dim> origin = x;
+  for (int d = 0; d < Dim; ++d) origin[d] -= u(fastest, d);
+  std::string surface;
+  if (const auto f = nodes.template find<double, 1>("free_surface"); f.valid()) {
+    surface = nodes.view(f)(fastest, 0) != 0.0 ? ", on the detected free surface" : ", inside the body";
+  }
+  return fmt::format(
+      ". The fastest node is at x = [{:.4g}] (at [{:.4g}] in the body as made), |v| = {:.3g} m/s{}, with {} stress "
+      "points and {} other nodes within its support (2h = {:.3g} m), the nearest node {:.2f} dx away",
+      fmt::join(x.data(), x.data() + Dim, ", "), fmt::join(origin.data(), origin.data() + Dim, ", "), std::sqrt(speed2),
+      surface, near_points, near_nodes, support, nearest / dx);
 }
 
 template <int Dim>

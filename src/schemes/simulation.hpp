@@ -146,6 +146,10 @@ class Simulation {
   /// A step from the current state this far below the initial one stops the run.
   static constexpr double kSmallestStepRatio = 1e-3;
   StepSums<Dim> balance_sums();
+  /// Where a growth shows first, for the growth guard's message: the fastest node, its
+  /// neighbours within the kernel's support (nodes and stress points), the nearest node and
+  /// whether it is on the detected free surface. Computed only when a run is stopped.
+  std::string fastest_node() const;
   /// The power of the loads: the boundary tractions and the scheme's extra power (bodies).
   double external_power();
 

@@ -20,7 +20,7 @@ void TimeControl<Dim>::start(double initial_strain, double boundary_power, const
 
 template <int Dim>
 void TimeControl<Dim>::end_step(const StepSums<Dim>& sums, double boundary_power, double imposed_kinetic,
-                                const std::string& hint) {
+                                const std::function<std::string()>& diagnosis) {
   const double dt = step_.dt;
   const double t_new = time_ + dt;
   const double fb = setup_.function_value(setup_.gravity_function, t_new);
@@ -56,7 +56,7 @@ void TimeControl<Dim>::end_step(const StepSums<Dim>& sums, double boundary_power
         "the kinetic energy of its prescribed velocities ({:.3g} J) at step {} (t = {:.6g} s): the run is unstable; "
         "reduce the time step (time.cfl = {:.3g}) or check the loads, the boundary conditions and the solver "
         "options{}",
-        kinetic, kEnergyGrowthLimit, budget, steps_ + 1, t_new, step_.courant, hint));
+        kinetic, kEnergyGrowthLimit, budget, steps_ + 1, t_new, step_.courant, diagnosis ? diagnosis() : ""));
   }
   last_power_ = power;
   last_damping_power_ = damping_power;

@@ -4,6 +4,7 @@
 // run while its state is still finite.
 #include <algorithm>
 #include <array>
+#include <functional>
 #include <limits>
 #include <string>
 
@@ -71,10 +72,11 @@ class TimeControl {
   /// not at set-up, so that a state set by the caller counts).
   void set_initial_energy(double energy) { initial_energy_ = energy; }
   /// After the stages of a step: account the energies, update the damping switch, check the
-  /// growth guard (throws SolverError with `hint` appended) and advance the clock.
-  /// `imposed_kinetic` is the kinetic energy of the prescribed velocity components, which the
-  /// guard's budget includes.
-  void end_step(const StepSums<Dim>& sums, double boundary_power, double imposed_kinetic, const std::string& hint);
+  /// growth guard (throws SolverError with what `diagnosis` returns appended; it is called only
+  /// then) and advance the clock. `imposed_kinetic` is the kinetic energy of the prescribed
+  /// velocity components, which the guard's budget includes.
+  void end_step(const StepSums<Dim>& sums, double boundary_power, double imposed_kinetic,
+                const std::function<std::string()>& diagnosis);
 
   /// Checkpoints: every value the clock carries (the step length is the case's).
   void save(io::StateArchive& archive) const;

@@ -741,13 +741,18 @@ cfl = {}
 // method-notes eq. (4.3.2)): impermeable faces carrying a total stress, undrained Courant number
 // C c_u / c_d above about 2.5 with the default (consistent) storage rate, 3.5 with the nodal one.
 // At C = 0.5 (C c_u/c_d = 7.1) the run must stop with a diagnosis while the state is still
-// finite (the energy growth guard), and at C = 0.15 (2.1) it runs.
+// finite (the energy growth guard: the V3 limit, and the fastest node with its neighbours), and at
+// C = 0.15 (2.1) it runs.
 TEST(Saturated, AnUnstableRunStopsWithADiagnosisWhileTheStateIsFinite) {
   const SampleRun unstable = run_loaded_impermeable_sample(0.5, "explicit", 0.02);
   const std::string& message = unstable.message;
   EXPECT_NE(message.find("kinetic energy"), std::string::npos) << message;
   EXPECT_NE(message.find("unstable"), std::string::npos) << message;
   EXPECT_NE(message.find("C c_u/c_d"), std::string::npos) << message;  // names the V3 limit and a safe cfl
+  // and where the growth shows: the fastest node, where it was made, its neighbours in the support
+  EXPECT_NE(message.find("The fastest node is at x = ["), std::string::npos) << message;
+  EXPECT_NE(message.find("in the body as made"), std::string::npos) << message;
+  EXPECT_NE(message.find("stress points and"), std::string::npos) << message;
   EXPECT_TRUE(std::isfinite(unstable.largest));
   const SampleRun stable = run_loaded_impermeable_sample(0.15, "explicit", 0.02);
   EXPECT_TRUE(stable.message.empty()) << stable.message;
