@@ -117,7 +117,7 @@ std::string Simulation<Dim>::fastest_node() const {
   for (int d = 0; d < Dim; ++d) origin[d] -= u(fastest, d);
   std::string surface;
   if (const auto f = nodes.template find<double, 1>("free_surface"); f.valid()) {
-    surface = nodes.view(f)(fastest, 0) != 0.0 ? ", on the detected free surface" : ", inside the body";
+    surface = nodes.view(f)(fastest, 0) != 0.0 ? ", flagged as free surface" : ", not flagged as free surface";
   }
   return fmt::format(
       ". The fastest node is at x = [{:.4g}] (at [{:.4g}] in the body as made), |v| = {:.3g} m/s{}, with {} stress "
