@@ -534,10 +534,10 @@ TEST(RigidBodies, BlockDraggedOverACoulombBaseSlidesAtTheFrictionLimit) {
 
 // The same rig for a second, under a plate of 2000 kg/m: the sliding stays steady. Under the
 // 200 kg/m plate of the test above a vibration grows from ~0.35 s (plate shear swinging by
-// +-3 kN/m by 0.4 s): the plate's vertical mode (88 Hz with mu = 0) and the block's shear mode
-// (83 Hz at this spacing and C = 0.5) lock to one frequency through the friction mu sigma_nn and
+// +-3 kN/m by 0.4 s): the plate's vertical mode (54 Hz with mu = 0) and the block's shear mode
+// (51 Hz, the quarter wave c_s/4H) lock to one frequency through the friction mu sigma_nn and
 // grow, a mode-coupling (flutter) instability of Coulomb friction with a constant coefficient
-// (docs/VALIDATION.md, "Rigid bodies"). The heavy plate's vertical mode (44 Hz) is far from the
+// (docs/VALIDATION.md, "Rigid bodies"). The heavy plate's vertical mode (27 Hz) is far from the
 // shear mode, and the vibration of the start of the drag decays: what is left is the contact
 // law itself over a long slide.
 TEST(RigidBodies, BlockDraggedUnderAHeavyPlateSlidesSteadilyForASecond) {
