@@ -48,7 +48,7 @@ void TimeControl<Dim>::end_step(const StepSums<Dim>& sums, double boundary_power
   // scheme's own energy error. The kinetic energy the prescribed velocities impose counts: a
   // kinematic load that starts on a body at rest (no load, no initial stress) moves its nodes
   // a step before their reaction has done any work, and the guard otherwise took the round-off
-  // of that first step (10^-11 J) for a growth.
+  // of that first step (10^-11 to 10^-7 J) for a growth.
   const double budget = std::abs(external_work_) + initial_energy_ + imposed_kinetic;
   if (kinetic > kEnergyGrowthLimit * budget && steps_ > 0) {
     throw SolverError(fmt::format(
