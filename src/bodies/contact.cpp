@@ -26,6 +26,11 @@ constexpr double kDepthOverDx = 1.0;
 constexpr double kAdjacentOverDx = 2.0;
 const double kCos45 = std::sqrt(0.5);
 
+// Whether a contact under `law` with Coulomb slip state `slip` holds the node's tangential motion.
+bool sticks(ContactLaw law, std::int8_t slip) {
+  return law == ContactLaw::rough || law == ContactLaw::bonded || (law == ContactLaw::coulomb && slip == 0);
+}
+
 // sigma n in 2D (slots xx, yy, zz, xy).
 Vec<2> traction(const double* s, const Vec<2>& n) {
   return Vec<2>(s[0] * n[0] + s[3] * n[1], s[3] * n[0] + s[1] * n[1]);
@@ -272,8 +277,7 @@ void RigidContact::end_step(double dt, std::vector<Vec<2>>& x, FieldView<double,
           if (sl != 0) add_shear(si, n, t, sl * tau - snt);
           slip_[slot] = sl;
         }
-        const bool stick = spec.law == ContactLaw::rough || spec.law == ContactLaw::bonded ||
-                           (spec.law == ContactLaw::coulomb && sl == 0);
+        const bool stick = sticks(spec.law, sl);
         // The kinematics: the normal motion (all laws) and, sticking, the tangential motion of the
         // step are the body's (method-notes eq. (4.5.2)).
         const Vec<2> step = x[i] - x_begin_[i] - dt * velocity_half_[bu];
@@ -327,6 +331,25 @@ void RigidContact::end_step(double dt, std::vector<Vec<2>>& x, FieldView<double,
     state_[b].work += 0.5 * dt * (last_power_[b] + p);
     last_power_[b] = p;
   }
+}
+
+double RigidContact::imposed_kinetic(ConstFieldView<double, 2> v, const std::function<double(Index)>& mass) const {
+  double energy = 0.0;
+  for (std::size_t i = 0; i < in_contact_.size(); ++i) {
+    if (in_contact_[i] == 0) continue;
+    const auto ii = static_cast<Index>(i);
+    const Vec<2> vi(v(ii, 0), v(ii, 1));
+    double prescribed = 0.0;  // v^2 of the prescribed components, at most |v|^2 (two bodies)
+    for (int k = 0; k < kMaxContacts; ++k) {
+      const std::size_t slot = kMaxContacts * i + static_cast<std::size_t>(k);
+      const int b = body_[slot];
+      if (b < 0) continue;
+      const double vn = vi.dot(normal_[slot]);
+      prescribed += sticks(bodies_[static_cast<std::size_t>(b)].spec().law, slip_[slot]) ? vi.squaredNorm() : vn * vn;
+    }
+    energy += 0.5 * mass(ii) * std::min(prescribed, vi.squaredNorm());
+  }
+  return energy;
 }
 
 void RigidContact::sort_along(std::size_t b, const std::vector<Vec<2>>& x) {

@@ -92,6 +92,10 @@ class RigidContact {
   void select_now(double t, const std::vector<Vec<2>>& x, ConstFieldView<double, 2> v, ConstFieldView<double, NS> s);
   bool selected() const { return selected_; }
 
+  /// Kinetic energy of the velocity components the bodies prescribe on their contact nodes, J/m
+  /// (the growth guard's budget): the normal one always, the whole velocity where a contact
+  /// sticks; `mass(i)` the node's mass.
+  double imposed_kinetic(ConstFieldView<double, 2> v, const std::function<double(Index)>& mass) const;
   /// Power of the bodies' tractions on the soil at the last measure, W/m: sum_I (-sigma_I n A_I).v_I.
   double power() const { return power_; }
   const std::vector<RigidBody>& bodies() const { return bodies_; }

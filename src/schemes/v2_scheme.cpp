@@ -12,7 +12,6 @@
 //      traction-free again on the stress at t^{n+1}.
 // With rigid bodies (2D, method-notes §4.5): the contact set at t^n after step 0 (its nodes are
 // never flagged as free surface), the contact constraints, projections and reactions after 3.
-#include <algorithm>
 #include <chrono>
 #include <functional>
 #include <memory>
@@ -106,26 +105,8 @@ std::unique_ptr<Scheme> make_v2_scheme(StaggeredModel<Dim>& model) {
       // The growth guard's budget: the contact nodes' components the bodies prescribe, the
       // normal one always and the tangential one where the contact sticks.
       scheme->extra_imposed_kinetic = [contact, &model] {
-        const auto v = std::as_const(model.nodes).view(model.fields.velocity);
-        const auto& in = contact->in_contact();
-        double energy = 0.0;
-        for (std::size_t i = 0; i < in.size(); ++i) {
-          if (in[i] == 0) continue;
-          const auto ii = static_cast<Index>(i);
-          const Vec<2> vi(v(ii, 0), v(ii, 1));
-          double prescribed = 0.0;  // v^2 of the prescribed components, at most |v|^2 (two bodies)
-          for (int k = 0; k < RigidContact::kMaxContacts; ++k) {
-            const int b = contact->contact_body(i, k);
-            if (b < 0) continue;
-            const ContactLaw law = contact->bodies()[static_cast<std::size_t>(b)].spec().law;
-            const bool stick = law == ContactLaw::rough || law == ContactLaw::bonded ||
-                               (law == ContactLaw::coulomb && contact->slip(i, k) == 0);
-            const double vn = vi.dot(contact->contact_normal(i, k));
-            prescribed += stick ? vi.squaredNorm() : vn * vn;
-          }
-          energy += 0.5 * model.nodes.mass(ii) * std::min(prescribed, vi.squaredNorm());
-        }
-        return energy;
+        return contact->imposed_kinetic(std::as_const(model.nodes).view(model.fields.velocity),
+                                        [&model](Index i) { return model.nodes.mass(i); });
       };
     }
   }
