@@ -34,3 +34,10 @@ add_test(NAME fos_quick
                  --out ${CMAKE_BINARY_DIR}/test-out/fos_quick --scale 3.4 --low 3.64 --high 4.00
                  -- --set geometry.spacing=0.5 --tol 0.02 --jobs 2 --threads 2 --quiet)
 set_tests_properties(fos_quick PROPERTIES LABELS validation PROCESSORS 2 TIMEOUT 600)
+
+# Every case file shipped under cases/ is sound: `rktsph check` reads it as `run` (or
+# `material-point`) would and builds its particles and solver, without running it. A key renamed
+# or a default changed without updating the files fails here, not in a user's run. Under a second.
+file(GLOB RKTSPH_SHIPPED_CASES CONFIGURE_DEPENDS ${PROJECT_SOURCE_DIR}/cases/*/*.toml)
+add_test(NAME shipped_case_files COMMAND rktsph check ${RKTSPH_SHIPPED_CASES})
+set_tests_properties(shipped_case_files PROPERTIES LABELS integration)

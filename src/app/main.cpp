@@ -13,8 +13,9 @@
 #include <fmt/format.h>
 #include <CLI/CLI.hpp>
 
-#include "app/lem_command.hpp"
+#include "app/check_case.hpp"
 #include "app/fos.hpp"
+#include "app/lem_command.hpp"
 #include "app/material_point.hpp"
 #include "app/run_case.hpp"
 #include "case/material_reader.hpp"
@@ -93,6 +94,7 @@ int main(int argc, char** argv) {
       "Examples:\n"
       "  rktsph run cases/thesis/01_elastic_bar_1d.toml\n"
       "  rktsph run case.toml --out runs/stiff --set material.E=2.5e7 --threads 2\n"
+      "  rktsph check cases/examples/*.toml\n"
       "  rktsph material-point cases/material_point/cam_clay_drained_nc.toml\n"
       "  rktsph lem cases/examples/slope_2to1_c10_phi20.toml\n"
       "  rktsph fos cases/thesis/05_viscoplastic_cut_2d.toml --tol 0.02\n"};
@@ -120,6 +122,14 @@ int main(int argc, char** argv) {
   resume_cmd->add_option("--threads,-j", resume.threads, "Number of threads (default and bound as for run)")
       ->check(CLI::NonNegativeNumber);
   resume_cmd->add_flag("--quiet,-q", resume.quiet, "No progress output");
+
+  CheckOptions check;
+  auto* check_cmd = app.add_subcommand(
+      "check", "Check case files without running them: particles, solver, time step and steps to the end");
+  check_cmd->add_option("cases", check.files, "Case files (TOML; material-point files too)")
+      ->required()
+      ->check(CLI::ExistingFile);
+  check_cmd->add_option("--set,-s", check.overrides, "Override a case key in every file, as for run");
 
   std::string mp_file, mp_out;
   std::vector<std::string> mp_overrides;
@@ -208,6 +218,7 @@ int main(int argc, char** argv) {
       exec::adaptive_teams() = false;
       return run_fos(fos);
     }
+    if (check_cmd->parsed()) return check_cases(check);
     if (mp_cmd->parsed()) return run_material_point(mp_file, mp_out, mp_overrides);
     if (lem_cmd->parsed()) return run_lem(lem_opt);
     if (val_cmd->parsed()) {

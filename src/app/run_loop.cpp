@@ -95,6 +95,36 @@ struct LoopState {
 }  // namespace
 
 template <int Dim>
+Index probe_node(const ProbeSpec& spec, const ParticleSet<Dim>& nodes, double dx) {
+  Vec<Dim> x;
+  for (int d = 0; d < Dim; ++d) x[d] = spec.position[static_cast<std::size_t>(d)];
+  Index best = 0;
+  double best_d = std::numeric_limits<double>::infinity();
+  for (Index i = 0; i < nodes.size(); ++i) {
+    const double dist = (nodes.position[static_cast<std::size_t>(i)] - x).norm();
+    if (dist < best_d) {
+      best_d = dist;
+      best = i;
+    }
+  }
+  if (best_d > 0.5 * std::sqrt(static_cast<double>(Dim)) * dx + 1e-9) {
+    throw InputError(fmt::format("{}: probe '{}' at [{}] lies outside the body (nearest node is {:.4g} m away)",
+                                 spec.where, spec.name, fmt::join(spec.position, ", "), best_d));
+  }
+  return best;
+}
+
+template <int Dim>
+io::ScalarField probe_field(const ProbeSpec& spec, const std::string& field, const io::FieldCatalogue<Dim>& nodes) {
+  auto value = nodes.scalar(field);
+  if (!value) {
+    throw InputError(fmt::format("{}, key 'probe.fields': unknown field '{}' for probe '{}' (available: {})",
+                                 spec.where, field, spec.name, fmt::join(nodes.scalar_names(), ", ")));
+  }
+  return std::move(*value);
+}
+
+template <int Dim>
 int run_loop(const LoopInput& in) {
   const RunOptions& opt = in.options;
   const fs::path& out = in.out;
@@ -119,30 +149,9 @@ int run_loop(const LoopInput& in) {
   std::vector<Probe> probes;
   const auto& nodes = solver.nodes();
   for (const ProbeSpec& spec : setup.probes) {
-    Vec<Dim> x;
-    for (int d = 0; d < Dim; ++d) x[d] = spec.position[static_cast<std::size_t>(d)];
-    Index best = 0;
-    double best_d = std::numeric_limits<double>::infinity();
-    for (Index i = 0; i < nodes.size(); ++i) {
-      const double dist = (nodes.position[static_cast<std::size_t>(i)] - x).norm();
-      if (dist < best_d) {
-        best_d = dist;
-        best = i;
-      }
-    }
-    if (best_d > 0.5 * std::sqrt(static_cast<double>(Dim)) * setup.dx + 1e-9) {
-      throw InputError(fmt::format("{}: probe '{}' at [{}] lies outside the body (nearest node is {:.4g} m away)",
-                                   spec.where, spec.name, fmt::join(spec.position, ", "), best_d));
-    }
+    const Index best = probe_node(spec, nodes, setup.dx);
     Probe p{spec.name, best, nodes.global_id[static_cast<std::size_t>(best)], {}};
-    for (const auto& f : spec.fields) {
-      auto value = node_fields.scalar(f);
-      if (!value) {
-        throw InputError(fmt::format("{}, key 'probe.fields': unknown field '{}' for probe '{}' (available: {})",
-                                     spec.where, f, spec.name, fmt::join(node_fields.scalar_names(), ", ")));
-      }
-      p.fields.emplace_back(f, std::move(*value));
-    }
+    for (const auto& f : spec.fields) p.fields.emplace_back(f, probe_field(spec, f, node_fields));
     probes.push_back(std::move(p));
   }
   // After the probes: a probe follows the node nearest its position as the case made the nodes,
@@ -737,5 +746,9 @@ int run_loop(const LoopInput& in) {
 
 template int run_loop<1>(const LoopInput&);
 template int run_loop<2>(const LoopInput&);
+template Index probe_node<1>(const ProbeSpec&, const ParticleSet<1>&, double);
+template Index probe_node<2>(const ProbeSpec&, const ParticleSet<2>&, double);
+template io::ScalarField probe_field<1>(const ProbeSpec&, const std::string&, const io::FieldCatalogue<1>&);
+template io::ScalarField probe_field<2>(const ProbeSpec&, const std::string&, const io::FieldCatalogue<2>&);
 
 }  // namespace rktsph
