@@ -346,8 +346,8 @@ CaseReport validate_case08(const Options& opt, const std::string& dir) {
     if (!m.pass()) {
       m.known_deviation = fmt::format(
           "open: the run stops at {:.2f} s ({:.0f} % elongation): the neck stretches the node columns apart along the "
-          "bar (gaps below) until the operators lose their neighbours; V2 has no particle regularisation yet "
-          "(issue 12). The solver's diagnosis: {}",
+          "bar (gaps below) until the operators lose their neighbours; the regularisation (solver.reseed, "
+          "solver.shift, off in the case) stops it sooner (docs/VALIDATION.md). The solver's diagnosis: {}",
           r.t_reached, 100.0 * r.t_reached * 2.0 * kGripSpeed / kLength, r.stopped);
     }
     rep.metrics.push_back(m);

@@ -246,8 +246,9 @@ CaseReport validate_case09(const Options& opt, const std::string& dir) {
       "open: the run goes unstable at t = {:.2f} s, long before a deposit forms (the figure is the last state's): "
       "nodes that reach the rough base or the smooth wall are put on it and stick (base) or slide on it (wall) beside "
       "nodes already there, and cluster (nearest-neighbour distance down to {:.3f} dx); the corrected operators over "
-      "the cluster blow up and the growth guard stops the run. V2 has no particle regularisation or contact "
-      "repulsion (issue 12 item 5); the flow is also slowed by the simple scheme's diffusion (front at 1 s {:.1f} m)",
+      "the cluster blow up and the growth guard stops the run. The regularisation (solver.reseed) is off in the "
+      "case: re-seeded, the run completes at C = 0.4-0.45 and stops at C = 0.35, 0.5, 0.55 (docs/VALIDATION.md); "
+      "the flow is also slowed by the simple scheme's diffusion (front at 1 s {:.1f} m)",
       r.t_end, nn_min, [&] {
         for (const Record& x : r.records) {
           if (x.t >= 1.0 - 1e-9) return x.front;
