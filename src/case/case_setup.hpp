@@ -248,6 +248,11 @@ struct CaseSetup {
   /// V2: the nodal velocity of step 2 by the simple scheme (method-notes §2.3), or V1's
   /// Taylor-Galerkin step 2 (solver.velocity_update = "taylor_galerkin", for comparison).
   bool simple_velocity = true;
+  /// The corrected operators' gradient floor (method-notes eq. (3.2.6); solver.gradient_floor):
+  /// a row whose gradient renormalisation matrix has an eigenvalue below it (a thin sheet of
+  /// particles, a lone particle) is regularised. The reader's default: 0.05 for V2 (0.025 in
+  /// 3D), below every row of a lattice at h = 1.2 dx; 0 (off) for V1 and V3.
+  double gradient_floor = 0.0;
   /// The traction-free surface (method-notes §3.6-3.7, §4.1): on the faces of the initial
   /// lattice in global axes (V1, V3, and V2 in 1D), or, for V2 in 2D and 3D, detected on the
   /// current positions every step with its normals, the stress rotated to sigma.n = 0 there

@@ -90,7 +90,7 @@ struct PatternTable {
   std::vector<double> geometry;
   std::vector<double> interp;
   std::vector<std::array<double, Dim>> grad;
-  std::vector<char> degenerate;
+  std::vector<char> flags;  // per pattern: 1 degenerate, 2 regularised by the gradient floor
   std::vector<std::uint64_t> key;
   std::vector<Index> next_same_key;  // chain of the patterns that share a hash
   std::unordered_map<std::uint64_t, Index> head;
@@ -120,14 +120,14 @@ struct PatternTable {
 
   // Append a pattern (its weights in interp/grad[first, first + n) of `w`); returns its id.
   Index add(std::uint64_t k, const Index* off, const double* geo, std::size_t n, const double* wi,
-            const std::array<double, Dim>* wg, bool degen, bool index) {
+            const std::array<double, Dim>* wg, char pattern_flags, bool index) {
     const Index id = size();
     offset.insert(offset.end(), off, off + n);
     geometry.insert(geometry.end(), geo, geo + n * G);
     interp.insert(interp.end(), wi, wi + n);
     grad.insert(grad.end(), wg, wg + n);
     start.push_back(static_cast<Index>(offset.size()));
-    degenerate.push_back(degen ? 1 : 0);
+    flags.push_back(pattern_flags);
     key.push_back(k);
     next_same_key.push_back(-1);
     if (index) {
@@ -144,11 +144,13 @@ struct PatternTable {
 };
 
 // The weights M_a^{-1} V_b [W_ab; h grad_a W_ab] of one row (method-notes §3.2), in units of h so
-// that the (n_d+1) system is well scaled. Returns false if the row is degenerate.
+// that the (n_d+1) system is well scaled, with the gradient floor of eq. (3.2.6). Returns 1 if
+// the row is degenerate, 2 if the floor regularised it, 0 otherwise.
 template <int Dim>
-bool row_weights(const std::vector<Pair<Dim>>& pairs, const ParticleSet<Dim>& sources,
-                 const CubicSplineKernel<Dim>& kernel, std::vector<Eigen::Matrix<double, Dim + 1, 1>>& basis,
-                 std::vector<double>& wi, std::vector<std::array<double, Dim>>& wg) {
+char row_weights(const std::vector<Pair<Dim>>& pairs, const ParticleSet<Dim>& sources,
+                 const CubicSplineKernel<Dim>& kernel, double gradient_floor,
+                 std::vector<Eigen::Matrix<double, Dim + 1, 1>>& basis, std::vector<double>& wi,
+                 std::vector<std::array<double, Dim>>& wg) {
   constexpr int N = Dim + 1;
   using MatN = Eigen::Matrix<double, N, N>;
   using VecN = Eigen::Matrix<double, N, 1>;
@@ -172,6 +174,7 @@ bool row_weights(const std::vector<Pair<Dim>>& pairs, const ParticleSet<Dim>& so
     basis[k] = w;
     shepard += w[0];
   }
+  const bool regularised = apply_gradient_floor<Dim>(M, gradient_floor);
   // M is O(1) in these units; a tiny determinant means too few or collinear sources.
   const bool ok = n > 0 && std::abs(M.determinant()) > 1e-8;
   const MatN Minv = ok ? MatN(M.inverse()) : MatN::Identity();
@@ -188,7 +191,7 @@ bool row_weights(const std::vector<Pair<Dim>>& pairs, const ParticleSet<Dim>& so
     wi[k] = c[0];
     for (int d = 0; d < Dim; ++d) wg[k][static_cast<std::size_t>(d)] = c[d + 1] / h;
   }
-  return ok;
+  return !ok ? 1 : regularised ? 2 : 0;
 }
 
 }  // namespace
@@ -238,8 +241,8 @@ CorrectedOperator<Dim> build_corrected_operator(const Relation<Dim>& relation, c
           Index p = share ? table.find(row.key, row.offset.data(), row.geometry.data(), n, tol_x, tol_v) : -1;
           if (p < 0) {
             // A new geometry: its weights are computed once, here.
-            const bool ok = row_weights<Dim>(row.pairs, sources, kernel, basis, wi, wg);
-            p = table.add(row.key, row.offset.data(), row.geometry.data(), n, wi.data(), wg.data(), !ok, share);
+            const char flags = row_weights<Dim>(row.pairs, sources, kernel, options.gradient_floor, basis, wi, wg);
+            p = table.add(row.key, row.offset.data(), row.geometry.data(), n, wi.data(), wg.data(), flags, share);
           }
           pattern[au] = p;
         }
@@ -260,7 +263,7 @@ CorrectedOperator<Dim> build_corrected_operator(const Relation<Dim>& relation, c
       Index g = share ? all.find(table.key[qu], &table.offset[b], &table.geometry[b * G], n, tol_x, tol_v) : -1;
       if (g < 0) {
         g = all.add(table.key[qu], &table.offset[b], &table.geometry[b * G], n, &table.interp[b], &table.grad[b],
-                    table.degenerate[qu] != 0, share);
+                    table.flags[qu], share);
       }
       map[qu] = g;
     }
@@ -289,7 +292,8 @@ CorrectedOperator<Dim> build_corrected_operator(const Relation<Dim>& relation, c
   for (Index a = 0; a < nt; ++a) {
     const auto p = static_cast<std::size_t>(op.pattern[static_cast<std::size_t>(a)]);
     op.pair_count += static_cast<std::size_t>(op.pattern_start[p + 1] - op.pattern_start[p]);
-    if (all.degenerate[p] != 0) ++op.degenerate_rows;
+    if (all.flags[p] == 1) ++op.degenerate_rows;
+    if (all.flags[p] == 2) ++op.regularised_rows;
   }
   return op;
 }
@@ -311,7 +315,7 @@ CorrectedOperator<Dim> build_corrected_operator(const std::vector<Vec<Dim>>& tar
 template <int Dim>
 void rebuild_corrected_operator(const Relation<Dim>& candidates, const std::vector<Vec<Dim>>& targets,
                                 const ParticleSet<Dim>& sources, const CubicSplineKernel<Dim>& kernel,
-                                CorrectedOperator<Dim>& op, const exec::Threads& policy) {
+                                CorrectedOperator<Dim>& op, const exec::Threads& policy, double gradient_floor) {
   const auto nt = static_cast<Index>(targets.size());
   if (candidates.rows() != nt || !candidates.options().sorted) {
     throw SolverError("corrected operator: the candidate relation must have one sorted row per target");
@@ -342,7 +346,7 @@ void rebuild_corrected_operator(const Relation<Dim>& candidates, const std::vect
   const Index nblocks = (nt + kBuildBlock - 1) / kBuildBlock;
   // Degenerate rows are rare and counted from any thread (an integer sum: the same whatever the
   // order). Not a thread_local: each worker would see its own, empty, copy.
-  std::atomic<Index> degenerate{0};
+  std::atomic<Index> degenerate{0}, regularised{0};
   std::atomic<bool> mismatch{false};
   exec::particle_for(
       policy, nblocks,
@@ -352,10 +356,11 @@ void rebuild_corrected_operator(const Relation<Dim>& candidates, const std::vect
         const Index end = std::min(nt, (blk + 1) * kBuildBlock);
         for (Index a = blk * kBuildBlock; a < end; ++a) {
           const auto au = static_cast<std::size_t>(a);
-          if (!row.evaluate(candidates.row(a), targets[au], sources.position.data(), sources.volume.data(), kernel,
-                            r2)) {
+          if (!row.evaluate(candidates.row(a), targets[au], sources.position.data(), sources.volume.data(), kernel, r2,
+                            gradient_floor)) {
             degenerate.fetch_add(1, std::memory_order_relaxed);
           }
+          if (row.regularised()) regularised.fetch_add(1, std::memory_order_relaxed);
           const auto k0 = static_cast<std::size_t>(op.pattern_start[au]);
           if (row.size() != static_cast<std::size_t>(op.pattern_start[au + 1]) - k0) {
             mismatch.store(true, std::memory_order_relaxed);
@@ -377,6 +382,7 @@ void rebuild_corrected_operator(const Relation<Dim>& candidates, const std::vect
   for (Index a = 0; a <= nt; ++a) op.run_start[static_cast<std::size_t>(a)] = a;
   op.pair_count = pairs;
   op.degenerate_rows = degenerate.load();
+  op.regularised_rows = regularised.load();
 }
 
 namespace {
@@ -594,7 +600,7 @@ std::vector<double> odd_even_amplitude(const CorrectedOperator<Dim>& op, const s
                                                             const CubicSplineKernel<D>&, const OperatorOptions&);    \
   template void rebuild_corrected_operator<D>(const Relation<D>&, const std::vector<Vec<D>>&, const ParticleSet<D>&, \
                                               const CubicSplineKernel<D>&, CorrectedOperator<D>&,                    \
-                                              const exec::Threads&);                                                 \
+                                              const exec::Threads&, double);                                         \
   template CorrectedOperator<D> quadratic_exact_gradient<D>(const CorrectedOperator<D>&, const std::vector<Vec<D>>&, \
                                                             const ParticleSet<D>&, const CubicSplineKernel<D>&,      \
                                                             double, const std::vector<char>*, Index*);               \

@@ -53,6 +53,7 @@ struct CorrectedOperator {
   static constexpr Index kMaxRun = 16;
   std::vector<Index> run_start;  // rows of run r: [run_start[r], run_start[r+1])
   Index degenerate_rows = 0;     // rows that fell back to Shepard / uncorrected (too few sources)
+  Index regularised_rows = 0;    // rows shifted by the gradient floor (method-notes eq. (3.2.6))
   std::size_t pair_count = 0;    // pairs summed over all rows (the uncompressed CSR length)
 
   /// The pairs of one row: k in [begin, end) indexes offset/interp/grad, the source of pair k
@@ -96,6 +97,8 @@ struct OperatorOptions {
   /// to round-off share its pattern and weights. false: one pattern per row, every row's
   /// weights computed from its own geometry (the reference the tests compare against).
   bool share_patterns = true;
+  /// The gradient floor of method-notes eq. (3.2.6) (solver.gradient_floor; 0: none).
+  double gradient_floor = 0.0;
 };
 
 /// The relation the corrected operator is built from: sources within the support (less a
@@ -123,11 +126,12 @@ CorrectedOperator<Dim> build_corrected_operator(const std::vector<Vec<Dim>>& tar
 /// sources of row a those of `candidates` row a (sorted, e.g. a Verlet list with a skin) that lie
 /// within the support (less the relative 1e-10 of operator_relation_options). The weights are
 /// those of build_corrected_operator without pattern sharing; op's storage is reused, so once it
-/// has grown nothing is allocated.
+/// has grown nothing is allocated. `gradient_floor` as OperatorOptions's.
 template <int Dim>
 void rebuild_corrected_operator(const Relation<Dim>& candidates, const std::vector<Vec<Dim>>& targets,
                                 const ParticleSet<Dim>& sources, const CubicSplineKernel<Dim>& kernel,
-                                CorrectedOperator<Dim>& op, const exec::Threads& policy = {});
+                                CorrectedOperator<Dim>& op, const exec::Threads& policy = {},
+                                double gradient_floor = 0.0);
 
 /// The gradient of `op` made exact for quadratic fields on every row (the pressure filter's
 /// gradient, method-notes eq. (2.4.11)): a pattern whose weights already are (a full support on a

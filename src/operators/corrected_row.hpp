@@ -13,7 +13,10 @@
 //               V2 step applies its operators this way, so that a step neither writes nor
 //               reads back the weights (28 bytes a pair).
 // A degenerate row (too few sources: |det M_a| <= 1e-8) falls back to Shepard interpolation
-// and the plain kernel gradient, in both uses.
+// and the plain kernel gradient, in both uses. With a gradient floor (solver.gradient_floor,
+// method-notes eq. (3.2.6)) a row whose gradient renormalisation matrix is nearly singular (a
+// thin sheet or a lone particle: the weights there grow without bound) is regularised instead,
+// keeping constant fields exact.
 #include <array>
 #include <cmath>
 #include <cstddef>
@@ -27,6 +30,46 @@
 
 namespace rktsph {
 
+/// The gradient floor of method-notes eq. (3.2.6) applied to a row's moment matrix M (in the
+/// units of h, where an interior row of a lattice has M = I): the Schur complement of the value
+/// block, S = M_gg - M_g0 M_0g / M_00, is the renormalisation matrix of the Shepard-difference
+/// gradient; each eigenvalue lambda_k of its symmetric part that lies below `floor` is raised to
+/// it by M_gg += (floor - lambda_k) e_k e_k^T. The first column of M is untouched, so that
+/// M^{-1} still maps a constant field to itself, and the directions the sources do span keep
+/// their linear exactness (along a sheet one particle thick, say); rows the floor does not reach
+/// are unchanged. Returns true if M was changed.
+template <int Dim>
+inline bool apply_gradient_floor(Eigen::Matrix<double, Dim + 1, Dim + 1>& M, double floor) {
+  if (!(floor > 0.0) || !(M(0, 0) > 0.0)) return false;
+  using MatD = Eigen::Matrix<double, Dim, Dim>;
+  MatD S;
+  for (int i = 0; i < Dim; ++i)
+    for (int j = 0; j < Dim; ++j) S(i, j) = M(1 + i, 1 + j) - M(1 + i, 0) * M(0, 1 + j) / M(0, 0);
+  const MatD sym = 0.5 * (S + S.transpose());
+  if constexpr (Dim == 1) {
+    if (!(sym(0, 0) < floor)) return false;
+    M(1, 1) += floor - sym(0, 0);
+    return true;
+  } else {
+    if constexpr (Dim == 2) {
+      // The smaller eigenvalue in closed form first: most rows stop here.
+      const double mean = 0.5 * (sym(0, 0) + sym(1, 1)), half = 0.5 * (sym(0, 0) - sym(1, 1));
+      if (!(mean - std::sqrt(half * half + sym(0, 1) * sym(0, 1)) < floor)) return false;
+    }
+    Eigen::SelfAdjointEigenSolver<MatD> eigen;
+    eigen.computeDirect(sym);
+    bool changed = false;
+    for (int k = 0; k < Dim; ++k) {
+      const double lambda = eigen.eigenvalues()(k);
+      if (!(lambda < floor)) continue;
+      const auto e = eigen.eigenvectors().col(k);
+      M.template bottomRightCorner<Dim, Dim>() += (floor - lambda) * (e * e.transpose());
+      changed = true;
+    }
+    return changed;
+  }
+}
+
 template <int Dim>
 class CorrectedRow {
  public:
@@ -34,13 +77,15 @@ class CorrectedRow {
 
   /// The candidates of target xa (any order) with |x_a - x_b|^2 < r2, kept in candidate order,
   /// their basis and the moment matrix. `position` and `volume` are the sources' (indexed by
-  /// the candidates). Returns false for a degenerate row. Allocates only while the work space
-  /// grows.
+  /// the candidates); `gradient_floor` as in apply_gradient_floor (0: none). Returns false for a
+  /// degenerate row. Allocates only while the work space grows.
   bool evaluate(std::span<const Index> candidates, const Vec<Dim>& xa, const Vec<Dim>* position, const double* volume,
-                const CubicSplineKernel<Dim>& kernel, double r2) {
+                const CubicSplineKernel<Dim>& kernel, double r2, double gradient_floor = 0.0) {
     gather(candidates, xa, position, volume, r2);
-    return moments(kernel);
+    return moments(kernel, gradient_floor);
   }
+  /// Whether the last row evaluated was regularised by the gradient floor.
+  bool regularised() const { return regularised_; }
 
   std::size_t size() const { return n_; }
   /// The sources of the row, in candidate order.
@@ -161,7 +206,7 @@ class CorrectedRow {
 
   // The basis V_b [W_ab; h grad_a W_ab] (grad_a W_ab = W'/r x_ab) and
   // M = sum_b w_b (x) [1, (x_b - x_a)/h] (O(1) in these units); M^{-1} unless degenerate.
-  bool moments(const CubicSplineKernel<Dim>& kernel) {
+  bool moments(const CubicSplineKernel<Dim>& kernel, double gradient_floor) {
     using MatN = Eigen::Matrix<double, N, N>;
     inv_h_ = kernel.inv_h();
     const double inv_h = inv_h_, alpha = kernel.alpha();
@@ -201,6 +246,7 @@ class CorrectedRow {
       }
     }
     shepard_ = M(0, 0);
+    regularised_ = apply_gradient_floor<Dim>(M, gradient_floor);
     if constexpr (N == 3) {
       // By cofactors, the determinant from the same ones: Eigen's determinant() and inverse()
       // computed it twice (about a sixth of the V2 step in a perf profile of BM_V2Step).
@@ -261,6 +307,7 @@ class CorrectedRow {
   double minv_[N][N] = {};
   double shepard_ = 0.0, inv_h_ = 0.0;
   bool ok_ = false;
+  bool regularised_ = false;
 };
 
 }  // namespace rktsph

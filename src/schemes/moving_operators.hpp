@@ -1,6 +1,7 @@
 #pragma once
 // What V2's steps need to apply their corrected operators on the fly (method-notes §5.2,
-// "Operators on the fly"), and the record of the operators' degenerate rows in either storage.
+// "Operators on the fly"), and the record of the operators' degenerate and regularised rows in
+// either storage.
 // RebuildOperators (schemes/v2_stages.hpp) owns it and keeps the candidate relations current;
 // step 1 saves the stress points' positions and volumes at t^n here before it moves them, so
 // that step 2's operator is built on the geometry of t^n, as a stored operator rebuilt at the
@@ -31,9 +32,15 @@ struct MovingOperators {
   /// step, and the time they first appeared (-1: never). A body tearing apart shows here.
   Index degenerate_max = 0;
   double degenerate_first_time = -1.0;
-  void note_degenerate(Index rows, double t) {
-    if (rows > 0 && degenerate_first_time < 0.0) degenerate_first_time = t;
-    degenerate_max = std::max(degenerate_max, rows);
+  /// The same for the rows the gradient floor regularised (method-notes eq. (3.2.6)): a thin
+  /// sheet or a lone particle.
+  Index regularised_max = 0;
+  double regularised_first_time = -1.0;
+  void note_rows(Index degenerate, Index regularised, double t) {
+    if (degenerate > 0 && degenerate_first_time < 0.0) degenerate_first_time = t;
+    degenerate_max = std::max(degenerate_max, degenerate);
+    if (regularised > 0 && regularised_first_time < 0.0) regularised_first_time = t;
+    regularised_max = std::max(regularised_max, regularised);
   }
 
   /// Room for the stress points of a step (allocates only when re-seeding made more than ever).

@@ -62,7 +62,9 @@ PorePressureStage<Dim>::PorePressureStage(StaggeredModel<Dim>& model) : m_(model
 
   Relation<Dim> relation;
   relation.build(nodes.position, nodes.position, operator_relation_options(m_.kernel), m_.policy);
-  node_operator_ = build_corrected_operator<Dim>(relation, nodes.position, nodes, m_.kernel);
+  OperatorOptions options;
+  options.gradient_floor = m_.setup.gradient_floor;
+  node_operator_ = build_corrected_operator<Dim>(relation, nodes.position, nodes, m_.kernel, options);
   relation.build(nodes.position, nodes.position, laplacian_relation_options(m_.kernel), m_.policy);
   // The operators of the pressure system are built row by row into shared-pattern storage
   // (linear_solvers/pattern_matrix.hpp): no CSR copy of any of them at any time, so the set-up

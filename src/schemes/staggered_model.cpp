@@ -119,9 +119,11 @@ StaggeredModel<Dim>::StaggeredModel(CaseSetup<Dim> case_setup, exec::Threads thr
   {
     Relation<Dim> relation;
     relation.build(stress_points.position, nodes.position, operator_relation_options(kernel), policy);
-    to_stress_points = build_corrected_operator<Dim>(relation, stress_points.position, nodes, kernel);
+    OperatorOptions options;
+    options.gradient_floor = setup.gradient_floor;
+    to_stress_points = build_corrected_operator<Dim>(relation, stress_points.position, nodes, kernel, options);
     relation.build(nodes.position, stress_points.position, operator_relation_options(kernel), policy);
-    to_nodes = build_corrected_operator<Dim>(relation, nodes.position, stress_points, kernel);
+    to_nodes = build_corrected_operator<Dim>(relation, nodes.position, stress_points, kernel, options);
   }
 
   // Fields (the order is the order of the output frames).

@@ -167,6 +167,8 @@ class StaggeredModel {
   std::size_t operator_bytes() const;
   std::size_t pairs() const { return to_stress_points.pairs() + to_nodes.pairs(); }
   Index degenerate_operator_rows() const { return to_stress_points.degenerate_rows + to_nodes.degenerate_rows; }
+  /// Rows of the two operators regularised by the gradient floor (method-notes eq. (3.2.6)).
+  Index regularised_operator_rows() const { return to_stress_points.regularised_rows + to_nodes.regularised_rows; }
 
  private:
   const double* pore_pressure_ = nullptr;

@@ -48,28 +48,30 @@ struct OnTheFlySources {
 // are counted (integer sums: the same whatever the threads).
 struct RowCounts {
   Index degenerate = 0;
+  Index regularised = 0;  // by the gradient floor (method-notes eq. (3.2.6))
   std::size_t pairs = 0;
 };
 template <int Dim, class Use>
 RowCounts rows_on_the_fly(const exec::Threads& policy, const OnTheFlySources<Dim>& from,
-                          const CubicSplineKernel<Dim>& kernel, double r2, Use&& use) {
+                          const CubicSplineKernel<Dim>& kernel, double r2, double gradient_floor, Use&& use) {
   constexpr int NS = kStressComponents<Dim>;
   const auto rows = static_cast<Index>(from.targets.size());
   const Index nblocks = (rows + kOnTheFlyBlock - 1) / kOnTheFlyBlock;
-  std::atomic<Index> degenerate{0};
+  std::atomic<Index> degenerate{0}, regularised{0};
   std::atomic<std::size_t> pairs{0};
   exec::particle_for(
       policy, nblocks,
       [&](Index blk) {
         static thread_local CorrectedRow<Dim> row;
-        Index block_degenerate = 0;
+        Index block_degenerate = 0, block_regularised = 0;
         std::size_t block_pairs = 0;
         const Index end = std::min(rows, (blk + 1) * kOnTheFlyBlock);
         for (Index a = blk * kOnTheFlyBlock; a < end; ++a) {
           if (!row.evaluate(from.candidates.row(a), from.targets[static_cast<std::size_t>(a)], from.position,
-                            from.volume, kernel, r2)) {
+                            from.volume, kernel, r2, gradient_floor)) {
             ++block_degenerate;
           }
+          if (row.regularised()) ++block_regularised;
           block_pairs += row.size();
           double out_v[Dim + 1][Dim], out_s[Dim + 1][NS];
           row.template apply<Dim, NS>(from.velocity, from.stress, out_v, out_s);
@@ -79,10 +81,11 @@ RowCounts rows_on_the_fly(const exec::Threads& policy, const OnTheFlySources<Dim
           use(row, a, v, grad_v, sigma, grad_s);
         }
         if (block_degenerate > 0) degenerate.fetch_add(block_degenerate, std::memory_order_relaxed);
+        if (block_regularised > 0) regularised.fetch_add(block_regularised, std::memory_order_relaxed);
         pairs.fetch_add(block_pairs, std::memory_order_relaxed);
       },
       exec::Schedule::even, rows);
-  return {degenerate.load(), pairs.load()};
+  return {degenerate.load(), regularised.load(), pairs.load()};
 }
 
 // V2 (method-notes §1.3, §5.2): particle i of `set` after its rotation over dt: the density by
@@ -254,7 +257,7 @@ void StressPointHalfStep<Dim, PressureTerm, Motion>::run(const StepContext& c) {
       const OnTheFlySources<Dim> from{candidates,          sp.position,   nodes.position.data(),
                                       nodes.volume.data(), node_v.data(), node_s.data()};
       const RowCounts counts = rows_on_the_fly<Dim>(
-          m_.policy, from, m_.kernel, mo.r2,
+          m_.policy, from, m_.kernel, mo.r2, m_.setup.gradient_floor,
           [&](const CorrectedRow<Dim>& row, Index e, const double(&bar_v)[Dim], const double(&grad_v)[Dim][Dim],
               double(&bar_s)[NS], const double(&grad_s)[Dim][NS]) {
             const auto eu = static_cast<std::size_t>(e);
@@ -264,6 +267,7 @@ void StressPointHalfStep<Dim, PressureTerm, Motion>::run(const StepContext& c) {
                    [&](double* ks) { row.interpolate(node_k.data(), stride, ks); });
           });
       m_.to_stress_points.degenerate_rows = counts.degenerate;
+      m_.to_stress_points.regularised_rows = counts.regularised;
       m_.to_stress_points.pair_count = counts.pairs;
       if (sources) src.integrate(tau, m_.stress_point_sources, sp_s, sp_k);
       return;
@@ -510,12 +514,13 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
           candidates,  nodes.position, mo.stress_point_position.data(), mo.stress_point_volume.data(),
           sp_v.data(), sp_s.data()};
       const RowCounts counts =
-          rows_on_the_fly<Dim>(m_.policy, from, m_.kernel, mo.r2,
+          rows_on_the_fly<Dim>(m_.policy, from, m_.kernel, mo.r2, m_.setup.gradient_floor,
                                [&](const CorrectedRow<Dim>&, Index i, double(&v_half)[Dim], double(&grad_v)[Dim][Dim],
                                    double(&)[NS], double(&grad_s)[Dim][NS]) { update(i, grad_v, grad_s, v_half); });
       m_.to_nodes.degenerate_rows = counts.degenerate;
+      m_.to_nodes.regularised_rows = counts.regularised;
       m_.to_nodes.pair_count = counts.pairs;
-      moving_->note_degenerate(m_.degenerate_operator_rows(), c.t);
+      moving_->note_rows(m_.degenerate_operator_rows(), m_.regularised_operator_rows(), c.t);
       if (sources) src.integrate(dt, m_.node_sources, node_s, m_.nodes.view(m_.fields.history));
       return;
     }

@@ -181,20 +181,23 @@ void RebuildOperators<Dim>::run(const StepContext& c) {
     if (m_.to_nodes.rows() > 0) m_.to_nodes = {};
   } else {
     rebuild_corrected_operator<Dim>(to_stress_points_, m_.stress_points.position, m_.nodes, m_.kernel,
-                                    m_.to_stress_points, m_.policy);
-    rebuild_corrected_operator<Dim>(to_nodes_, m_.nodes.position, m_.stress_points, m_.kernel, m_.to_nodes, m_.policy);
+                                    m_.to_stress_points, m_.policy, m_.setup.gradient_floor);
+    rebuild_corrected_operator<Dim>(to_nodes_, m_.nodes.position, m_.stress_points, m_.kernel, m_.to_nodes, m_.policy,
+                                    m_.setup.gradient_floor);
   }
   build_difference_gradient_into<Dim>(constrained_, constrained_positions_, m_.stress_points, m_.kernel,
                                       m_.constrained_gradient);
   ++operator_builds_;
   operator_seconds_ += since(t0);
-  if (!moving_.on_the_fly) moving_.note_degenerate(m_.degenerate_operator_rows(), c.t);
+  if (!moving_.on_the_fly) moving_.note_rows(m_.degenerate_operator_rows(), m_.regularised_operator_rows(), c.t);
 }
 
 template <int Dim>
 void RebuildOperators<Dim>::save(io::StateArchive& a, const std::string& prefix) const {
   a.put_integer(prefix + "degenerate_max", moving_.degenerate_max);
   a.put(prefix + "degenerate_first_time", moving_.degenerate_first_time);
+  a.put_integer(prefix + "regularised_max", moving_.regularised_max);
+  a.put(prefix + "regularised_first_time", moving_.regularised_first_time);
   // The Verlet reference: when the next search is due, and with it the next sort.
   auto flat = [](const std::vector<Vec<Dim>>& x) {
     std::vector<double> out;
@@ -217,6 +220,10 @@ template <int Dim>
 void RebuildOperators<Dim>::load(const io::StateArchive& a, const std::string& prefix) {
   moving_.degenerate_max = static_cast<Index>(a.integer(prefix + "degenerate_max"));
   moving_.degenerate_first_time = a.number(prefix + "degenerate_first_time");
+  if (a.has(prefix + "regularised_max")) {  // absent from checkpoints written before the floor
+    moving_.regularised_max = static_cast<Index>(a.integer(prefix + "regularised_max"));
+    moving_.regularised_first_time = a.number(prefix + "regularised_first_time");
+  }
   if (!a.has(prefix + "verlet_nodes")) return;  // an older checkpoint: search (and sort) afresh
   if (a.has(prefix + "storage_gap")) {
     gap_ = a.number(prefix + "storage_gap");

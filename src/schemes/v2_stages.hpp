@@ -75,6 +75,8 @@ class RebuildOperators final : public Stage {
             {"verlet_skin", skin_},
             {"degenerate_rows_max", static_cast<double>(moving_.degenerate_max)},
             {"degenerate_rows_first_time", moving_.degenerate_first_time},
+            {"regularised_rows_max", static_cast<double>(moving_.regularised_max)},
+            {"regularised_rows_first_time", moving_.regularised_first_time},
             {"operators_on_the_fly", moving_.on_the_fly ? 1.0 : 0.0}};
   }
 

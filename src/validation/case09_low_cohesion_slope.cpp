@@ -246,8 +246,8 @@ CaseReport validate_case09(const Options& opt, const std::string& dir) {
       "open: the run goes unstable at t = {:.2f} s, long before a deposit forms (the figure is the last state's): "
       "nodes that reach the rough base or the smooth wall are put on it and stick (base) or slide on it (wall) beside "
       "nodes already there, and cluster (nearest-neighbour distance down to {:.3f} dx); the corrected operators over "
-      "the cluster blow up and the growth guard stops the run. The regularisation (solver.reseed) is off in the "
-      "case: re-seeded, the run completes at C = 0.4-0.45 and stops at C = 0.35, 0.5, 0.55 (docs/VALIDATION.md); "
+      "the cluster blow up and the growth guard stops the run. The gradient floor (solver.gradient_floor, "
+      "method-notes eq. (3.2.6)) makes the run at dx = 0.25 m complete (docs/VALIDATION.md); "
       "the flow is also slowed by the simple scheme's diffusion (front at 1 s {:.1f} m)",
       r.t_end, nn_min, [&] {
         for (const Record& x : r.records) {
@@ -255,8 +255,18 @@ CaseReport validate_case09(const Options& opt, const std::string& dir) {
         }
         return r.records.back().front;
       }());
+  // Why the deposit of a run that completes misses (docs/VALIDATION.md Case 9, "The gradient
+  // floor"): the diagnosis, not a tolerance.
+  const std::string stiff = fmt::format(
+      "open: the run completes (the gradient floor of method-notes eq. (3.2.6) keeps the nose's operators bounded) "
+      "but the column does not flow out: it slumps as a block, the node columns parting along vertical lines (the "
+      "detected surface follows those gaps), and stops high and short (front {:.1f} m against x_f = {:.1f} m). The "
+      "simple scheme's averaging of the nodal velocity (method-notes §2.3) acts as a viscosity of order rho c_p dx "
+      "that a column whose cohesion is 1/50 of gamma H cannot overcome. A particle behind a body at a record "
+      "(one, once, in the quick run of 2026-12-05) is not located yet",
+      front, xf);
   auto push = [&](Metric m) {
-    if (!m.pass() && !r.stopped.empty()) m.known_deviation = unstable;
+    if (!m.pass()) m.known_deviation = r.stopped.empty() ? stiff : unstable;
     rep.metrics.push_back(std::move(m));
   };
   push(metric(tag + "final wall height / h0 (collapsed: <= 1.10)", wall / h0, "<=", 1.10, ""));

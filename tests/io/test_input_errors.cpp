@@ -188,6 +188,13 @@ TEST(InputErrors, ReseedFillOutOfRange) {
   expect_error_at(o, line_of(text, "reseed_fill"), "solver.reseed_fill", {"(0, 1]"});
 }
 
+TEST(InputErrors, GradientFloorOutOfRange) {
+  test::TempDir dir;
+  const std::string text = replace(kBase, "[time]", "[solver]\nversion = \"v2\"\ngradient_floor = -0.1\n[time]");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "gradient_floor"), "solver.gradient_floor", {"[0, 0.5]"});
+}
+
 TEST(InputErrors, ShiftingNeedsV2WithTheDetectedSurface) {
   test::TempDir dir;
   const std::string text =
