@@ -219,6 +219,8 @@ void BM_V2Step(benchmark::State& state) {
       .initial_velocity(Vec<2>::Zero(), 1e-3 * static_cast<double>(state.range(2)), Vec<2>(0.5 * length, 0.5 * length))
       .scheme("v2")
       .time(1.0, 0.5);
+  // The fifth argument: the gradient floor on (V2's default) or off, for its cost.
+  if (state.range(4) == 0) b.gradient_floor(0.0);
   CaseSetup<2> setup = b.build();
   // Storage (the fourth argument): the order the lattice was made in (rows) or shuffled, and
   // solver.sort off, "auto" (the default) or "always".
@@ -282,18 +284,21 @@ void BM_V2Step(benchmark::State& state) {
 // the order the lattice made the particles (rows) with solver.sort 0 "off", 1 "auto" (the
 // default: kept, rows do better than Morton order); shuffled first (what a long mixing flow
 // leaves) with 2 "off", 3 "auto" (sorted at the first search), 4 "always" (every search).
+// The fifth: the gradient floor on (1, V2's default) or off (0).
 BENCHMARK(BM_V2Step)
-    ->Args({10000, 1, 100, 1})
-    ->Args({100000, 1, 100, 1})
-    ->Args({100000, 1, 100, 0})
-    ->Args({100000, 1, 100, 2})
-    ->Args({100000, 1, 100, 3})
-    ->Args({100000, 1, 100, 4})
-    ->Args({100000, 2, 100, 1})
-    ->Args({100000, 1, 1000, 1})
-    ->Args({100000, 1, 1000, 3})
-    ->Args({100000, 1, 1000, 4})
-    ->Args({100000, 2, 1000, 1})
+    ->Args({10000, 1, 100, 1, 1})
+    ->Args({100000, 1, 100, 1, 1})
+    ->Args({100000, 1, 100, 1, 0})
+    ->Args({100000, 1, 100, 0, 1})
+    ->Args({100000, 1, 100, 2, 1})
+    ->Args({100000, 1, 100, 3, 1})
+    ->Args({100000, 1, 100, 4, 1})
+    ->Args({100000, 2, 100, 1, 1})
+    ->Args({100000, 2, 100, 1, 0})
+    ->Args({100000, 1, 1000, 1, 1})
+    ->Args({100000, 1, 1000, 3, 1})
+    ->Args({100000, 1, 1000, 4, 1})
+    ->Args({100000, 2, 1000, 1, 1})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 

@@ -155,10 +155,16 @@ class CaseBuilder {
     return *this;
   }
   /// The scheme by registry name ("v1", "v3", ...); V2 in 2D and 3D detects its free surface
-  /// by default, as the reader does.
+  /// by default, and V2 has the gradient floor (method-notes eq. (3.2.6)), as the reader does.
   CaseBuilder& scheme(const std::string& version) {
     c_.version = version;
     c_.detect_free_surface = version == "v2" && Dim >= 2;
+    c_.gradient_floor = version != "v2" ? 0.0 : Dim == 3 ? 0.025 : 0.05;
+    return *this;
+  }
+  /// solver.gradient_floor (method-notes eq. (3.2.6); 0: off).
+  CaseBuilder& gradient_floor(double floor) {
+    c_.gradient_floor = floor;
     return *this;
   }
   /// solver.free_surface: detected ("detect", V2 in 2D/3D) or the lattice faces ("faces").
