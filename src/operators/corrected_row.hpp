@@ -17,9 +17,11 @@
 // method-notes eq. (3.2.6)) a row whose gradient renormalisation matrix is nearly singular (a
 // thin sheet or a lone particle: the weights there grow without bound) is regularised instead,
 // keeping constant fields exact.
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <span>
 #include <vector>
 
@@ -42,6 +44,22 @@ template <int Dim>
 inline bool apply_gradient_floor(Eigen::Matrix<double, Dim + 1, Dim + 1>& M, double floor) {
   if (!(floor > 0.0) || !(M(0, 0) > 0.0)) return false;
   using MatD = Eigen::Matrix<double, Dim, Dim>;
+  // Gershgorin's discs first, on M_00 S (no division): every eigenvalue of sym(S) lies above
+  // min_i (S_ii - sum_j!=i |S_ij|), which settles the rows of a regular cloud (S near I).
+  if constexpr (Dim > 1) {
+    const double m00 = M(0, 0);
+    double lower = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < Dim; ++i) {
+      double radius = 0.0;
+      for (int j = 0; j < Dim; ++j) {
+        if (j == i) continue;
+        radius += std::abs(0.5 * (m00 * (M(1 + i, 1 + j) + M(1 + j, 1 + i)) - M(1 + i, 0) * M(0, 1 + j) -
+                                  M(1 + j, 0) * M(0, 1 + i)));
+      }
+      lower = std::min(lower, m00 * M(1 + i, 1 + i) - M(1 + i, 0) * M(0, 1 + i) - radius);
+    }
+    if (lower >= floor * m00) return false;
+  }
   MatD S;
   for (int i = 0; i < Dim; ++i)
     for (int j = 0; j < Dim; ++j) S(i, j) = M(1 + i, 1 + j) - M(1 + i, 0) * M(0, 1 + j) / M(0, 0);
@@ -52,7 +70,7 @@ inline bool apply_gradient_floor(Eigen::Matrix<double, Dim + 1, Dim + 1>& M, dou
     return true;
   } else {
     if constexpr (Dim == 2) {
-      // The smaller eigenvalue in closed form first: most rows stop here.
+      // The smaller eigenvalue in closed form next.
       const double mean = 0.5 * (sym(0, 0) + sym(1, 1)), half = 0.5 * (sym(0, 0) - sym(1, 1));
       if (!(mean - std::sqrt(half * half + sym(0, 1) * sym(0, 1)) < floor)) return false;
     }

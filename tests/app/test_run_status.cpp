@@ -83,34 +83,42 @@ cfl = 0.5
 )";
 }
 
-TEST(RunStatus, AV2BodyTearingApartIsReportedOnce) {
+// The tearing bar run with `solver_extra` in [solver]: the command's output and status, and
+// summary.json's record of the operator rebuilds.
+struct TearingRun {
+  test::CommandResult command;
+  nlohmann::json rebuild;
+};
+TearingRun run_tearing_bar(const std::string& solver_extra) {
   test::TempDir dir;
-  const std::string file = dir.write("case.toml", tearing_bar("gradient_floor = 0.0"));
-  const auto r = test::run_command(
+  const std::string file = dir.write("case.toml", tearing_bar(solver_extra));
+  TearingRun run;
+  run.command = test::run_command(
       fmt::format("\"{}\" run \"{}\" --out \"{}\" -q -j 1 2>&1", RKTSPH_BINARY, file, dir.file("out")));
+  const auto s = nlohmann::json::parse(test::read_text(dir.file("out/summary.json")));
+  run.rebuild = s.at("stages").at("rebuild_operators");
+  return run;
+}
+
+TEST(RunStatus, AV2BodyTearingApartIsReportedOnce) {
+  const TearingRun run = run_tearing_bar("gradient_floor = 0.0");
+  const auto& r = run.command;
   EXPECT_EQ(r.status, 0) << r.out;
   const std::string needle = "particles have too few neighbours for the corrected operator";
   const auto first = r.out.find(needle);
   ASSERT_NE(first, std::string::npos) << r.out;
   EXPECT_EQ(r.out.find(needle, first + 1), std::string::npos) << "warned more than once:\n" << r.out;
-  const auto s = nlohmann::json::parse(test::read_text(dir.file("out/summary.json")));
-  const auto& rebuild = s.at("stages").at("rebuild_operators");
-  EXPECT_GT(rebuild.at("degenerate_rows_max").get<double>(), 0.0);
-  EXPECT_GT(rebuild.at("degenerate_rows_first_time").get<double>(), 0.1);
-  EXPECT_EQ(rebuild.at("regularised_rows_max").get<double>(), 0.0);
+  EXPECT_GT(run.rebuild.at("degenerate_rows_max").get<double>(), 0.0);
+  EXPECT_GT(run.rebuild.at("degenerate_rows_first_time").get<double>(), 0.1);
+  EXPECT_EQ(run.rebuild.at("regularised_rows_max").get<double>(), 0.0);
 }
 
 TEST(RunStatus, AV2NeckThinningIsRegularisedByTheGradientFloor) {
-  test::TempDir dir;
-  const std::string file = dir.write("case.toml", tearing_bar(""));
-  const auto r = test::run_command(
-      fmt::format("\"{}\" run \"{}\" --out \"{}\" -q -j 1 2>&1", RKTSPH_BINARY, file, dir.file("out")));
-  EXPECT_EQ(r.status, 0) << r.out;
-  const auto s = nlohmann::json::parse(test::read_text(dir.file("out/summary.json")));
-  const auto& rebuild = s.at("stages").at("rebuild_operators");
+  const TearingRun run = run_tearing_bar("");
+  EXPECT_EQ(run.command.status, 0) << run.command.out;
   // From the first steps: the grips start at 3 m/s and pull away from the rows beside them.
-  EXPECT_GT(rebuild.at("regularised_rows_max").get<double>(), 0.0);
-  EXPECT_GT(rebuild.at("regularised_rows_first_time").get<double>(), 0.0);
+  EXPECT_GT(run.rebuild.at("regularised_rows_max").get<double>(), 0.0);
+  EXPECT_GT(run.rebuild.at("regularised_rows_first_time").get<double>(), 0.0);
 }
 
 }  // namespace
