@@ -53,8 +53,8 @@ inline bool apply_gradient_floor(Eigen::Matrix<double, Dim + 1, Dim + 1>& M, dou
       double radius = 0.0;
       for (int j = 0; j < Dim; ++j) {
         if (j == i) continue;
-        radius += std::abs(0.5 * (m00 * (M(1 + i, 1 + j) + M(1 + j, 1 + i)) - M(1 + i, 0) * M(0, 1 + j) -
-                                  M(1 + j, 0) * M(0, 1 + i)));
+        radius += std::abs(
+            0.5 * (m00 * (M(1 + i, 1 + j) + M(1 + j, 1 + i)) - M(1 + i, 0) * M(0, 1 + j) - M(1 + j, 0) * M(0, 1 + i)));
       }
       lower = std::min(lower, m00 * M(1 + i, 1 + i) - M(1 + i, 0) * M(0, 1 + i) - radius);
     }
