@@ -134,15 +134,24 @@ void expect_along_the_sheet(const CorrectedOperator<2>& op, const Sheet& sheet, 
   }
 }
 
+// A sheet at dx = 0.25 m, h = 1.2 dx, and its operator without the floor and with 0.05.
+struct SheetOperators {
+  Sheet sheet;
+  CubicSplineKernel<2> kernel;
+  CorrectedOperator<2> plain, floored;
+  explicit SheetOperators(bool ragged)
+      : sheet(sheet_of_sources(0.25, ragged)),
+        kernel(1.2 * 0.25),
+        plain(build<2>(sheet.targets, sheet.sources, kernel, 0.0)),
+        floored(build<2>(sheet.targets, sheet.sources, kernel, 0.05)) {}
+};
+
 // A straight sheet has no extent across itself: without the floor every row is degenerate
 // (Shepard and the plain kernel gradient); with it every row is regularised across the sheet
 // only, and stays exact for a linear field along it.
 TEST(GradientFloor, MakesAStraightSheetExactAlongItInsteadOfDegenerate) {
-  const double dx = 0.25;
-  const Sheet sheet = sheet_of_sources(dx, false);
-  const CubicSplineKernel<2> kernel(1.2 * dx);
-  const CorrectedOperator<2> plain = build<2>(sheet.targets, sheet.sources, kernel, 0.0);
-  const CorrectedOperator<2> floored = build<2>(sheet.targets, sheet.sources, kernel, 0.05);
+  const SheetOperators ops(false);
+  const auto& [sheet, kernel, plain, floored] = ops;
   EXPECT_EQ(plain.degenerate_rows, plain.rows());
   EXPECT_EQ(floored.degenerate_rows, 0);
   EXPECT_EQ(floored.regularised_rows, floored.rows());
@@ -155,11 +164,8 @@ TEST(GradientFloor, MakesAStraightSheetExactAlongItInsteadOfDegenerate) {
 // 3.4), keeps constants exact and a field along the sheet within 1 % (the deficient
 // direction is not exactly across the sheet, so the shift touches the other a little).
 TEST(GradientFloor, BoundsTheWeightsOfARaggedSheet) {
-  const double dx = 0.25;
-  const Sheet sheet = sheet_of_sources(dx, true);
-  const CubicSplineKernel<2> kernel(1.2 * dx);
-  const CorrectedOperator<2> plain = build<2>(sheet.targets, sheet.sources, kernel, 0.0);
-  const CorrectedOperator<2> floored = build<2>(sheet.targets, sheet.sources, kernel, 0.05);
+  const SheetOperators ops(true);
+  const auto& [sheet, kernel, plain, floored] = ops;
   EXPECT_EQ(plain.degenerate_rows, 0);
   EXPECT_EQ(floored.degenerate_rows, 0);
   EXPECT_GT(floored.regularised_rows, 0);
