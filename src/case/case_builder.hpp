@@ -159,7 +159,7 @@ class CaseBuilder {
   CaseBuilder& scheme(const std::string& version) {
     c_.version = version;
     c_.detect_free_surface = version == "v2" && Dim >= 2;
-    c_.gradient_floor = version != "v2" ? 0.0 : Dim == 3 ? 0.025 : 0.05;
+    c_.gradient_floor = default_gradient_floor<Dim>(version);
     return *this;
   }
   /// solver.gradient_floor (method-notes eq. (3.2.6); 0: off).

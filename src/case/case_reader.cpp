@@ -324,10 +324,7 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
       c.simple_velocity = false;
     else
       s->fail("velocity_update", fmt::format("unknown value '{}' (known: simple, taylor_galerkin)", velocity_update));
-    // 0.05 (2D, 1D) and 0.025 (3D) lie below every row of a lattice at the default h = 1.2 dx
-    // (the corner node's row from the stress points has 0.058 / 0.028), so that V2 regularises
-    // only rows off the lattice: a thin sheet, a lone particle (method-notes §3.2, eq. (3.2.6)).
-    c.gradient_floor = s->number("gradient_floor", c.version != "v2" ? 0.0 : Dim == 3 ? 0.025 : 0.05);
+    c.gradient_floor = s->number("gradient_floor", default_gradient_floor<Dim>(c.version));
     s->require(c.gradient_floor >= 0.0 && c.gradient_floor <= 0.5, "gradient_floor",
                fmt::format("must lie in [0, 0.5] (the smallest eigenvalue allowed for a row's gradient "
                            "renormalisation matrix, 1 inside a lattice; 0: off), got {}",

@@ -20,6 +20,16 @@ namespace rktsph {
 /// Default of time.max_steps: a run of more steps must say so in its case file.
 inline constexpr double kDefaultMaxSteps = 1.0e8;
 
+/// Default of solver.gradient_floor (method-notes eq. (3.2.6)) for a solver version: on for V2,
+/// at 0.05 in 1D and 2D and 0.025 in 3D, under every row of a lattice at h = 1.2 dx (the corner
+/// node's row from the stress points: 0.126 / 0.058 / 0.028); off (0) for V1 and V3, whose
+/// particles do not move.
+template <int Dim>
+double default_gradient_floor(const std::string& version) {
+  if (version != "v2") return 0.0;
+  return Dim == 3 ? 0.025 : 0.05;
+}
+
 /// Nodes selected by an axis-aligned box; an axis left open selects everything along it.
 template <int Dim>
 struct Region {
@@ -250,8 +260,7 @@ struct CaseSetup {
   bool simple_velocity = true;
   /// The corrected operators' gradient floor (method-notes eq. (3.2.6); solver.gradient_floor):
   /// a row whose gradient renormalisation matrix has an eigenvalue below it (a thin sheet of
-  /// particles, a lone particle) is regularised. The reader's default: 0.05 for V2 (0.025 in
-  /// 3D), below every row of a lattice at h = 1.2 dx; 0 (off) for V1 and V3.
+  /// particles, a lone particle) is regularised. The reader's default: default_gradient_floor.
   double gradient_floor = 0.0;
   /// The traction-free surface (method-notes §3.6-3.7, §4.1): on the faces of the initial
   /// lattice in global axes (V1, V3, and V2 in 1D), or, for V2 in 2D and 3D, detected on the

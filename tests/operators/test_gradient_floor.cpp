@@ -73,6 +73,30 @@ TEST(GradientFloor, LeavesEveryLatticeRowUntouched) {
   }
 }
 
+// The smallest eigenvalue over a block lattice's rows, as method-notes §3.2 tabulates it at
+// h = 1.2 dx and the defaults rely on: the corner node's row from the stress points, 0.126 /
+// 0.058 / 0.028 in 1D / 2D / 3D. A floor just under it touches no row, one just over it the
+// corner nodes' rows (2, 4, 8 of them) and nothing else.
+template <int Dim>
+void expect_lattice_threshold(double below, double above) {
+  const double dx = 0.25;
+  Block<Dim> block;
+  block.min = Vec<Dim>::Zero();
+  block.max = Vec<Dim>::Constant(1.5);
+  block.label = "block";
+  const LatticeParticles<Dim> lp = generate_lattice<Dim>({block}, dx, Vec<Dim>::Zero(), {1000.0});
+  const CubicSplineKernel<Dim> kernel(1.2 * dx);
+  EXPECT_EQ(build<Dim>(lp.nodes.position, lp.stress_points, kernel, below).regularised_rows, 0) << Dim << "D";
+  EXPECT_EQ(build<Dim>(lp.nodes.position, lp.stress_points, kernel, above).regularised_rows, 1 << Dim) << Dim << "D";
+  EXPECT_EQ(build<Dim>(lp.stress_points.position, lp.nodes, kernel, above).regularised_rows, 0) << Dim << "D";
+}
+
+TEST(GradientFloor, TheLatticesSmallestEigenvalueIsTheCornerNodesAsTabulated) {
+  expect_lattice_threshold<1>(0.125, 0.127);
+  expect_lattice_threshold<2>(0.058, 0.059);
+  expect_lattice_threshold<3>(0.028, 0.029);
+}
+
 // A sheet one particle thick seen from points on and beside it: straight (a row of sources),
 // or ragged (every fourth source doubled 0.2 dx below the row, the crowding at the nose of a
 // run-out).
