@@ -324,6 +324,15 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
       c.simple_velocity = false;
     else
       s->fail("velocity_update", fmt::format("unknown value '{}' (known: simple, taylor_galerkin)", velocity_update));
+    c.simple_weight = s->number("simple_weight", 1.0);
+    s->require(c.simple_weight > 0.0 && c.simple_weight <= 1.0, "simple_weight",
+               fmt::format("must lie in (0, 1] (the simple scheme's share of the nodal velocity update; "
+                           "1: the simple scheme), got {}",
+                           c.simple_weight));
+    if (s->has("simple_weight")) {
+      s->require(c.version == "v2" && c.simple_velocity, "simple_weight",
+                 "applies to V2's simple scheme (solver.version = \"v2\", velocity_update = \"simple\")");
+    }
     c.gradient_floor = s->number("gradient_floor", default_gradient_floor<Dim>(c.version));
     s->require(c.gradient_floor >= 0.0 && c.gradient_floor <= 0.5, "gradient_floor",
                fmt::format("must lie in [0, 0.5] (the smallest eigenvalue allowed for a row's gradient "

@@ -278,6 +278,7 @@ CorrectedOperator<Dim> build_corrected_operator(const Relation<Dim>& relation, c
   op.pattern = std::move(pattern);
   op.pattern_start = std::move(all.start);
   op.offset = std::move(all.offset);
+  op.row_kind = all.flags;
   op.interp = std::move(all.interp);
   op.grad = std::move(all.grad);
   op.run_start.push_back(0);
@@ -340,6 +341,7 @@ void rebuild_corrected_operator(const Relation<Dim>& candidates, const std::vect
   }
   const auto pairs = static_cast<std::size_t>(op.pattern_start.back());
   op.offset.resize(pairs);
+  op.row_kind.assign(static_cast<std::size_t>(nt), 0);
   op.interp.resize(pairs);
   op.grad.resize(pairs);
   // Pass 2: the weights, row by row (method-notes §3.2), in fixed blocks of rows.
@@ -359,8 +361,12 @@ void rebuild_corrected_operator(const Relation<Dim>& candidates, const std::vect
           if (!row.evaluate(candidates.row(a), targets[au], sources.position.data(), sources.volume.data(), kernel, r2,
                             gradient_floor)) {
             degenerate.fetch_add(1, std::memory_order_relaxed);
+            op.row_kind[au] = 1;
           }
-          if (row.regularised()) regularised.fetch_add(1, std::memory_order_relaxed);
+          if (row.regularised()) {
+            regularised.fetch_add(1, std::memory_order_relaxed);
+            if (op.row_kind[au] == 0) op.row_kind[au] = 2;
+          }
           const auto k0 = static_cast<std::size_t>(op.pattern_start[au]);
           if (row.size() != static_cast<std::size_t>(op.pattern_start[au + 1]) - k0) {
             mismatch.store(true, std::memory_order_relaxed);

@@ -45,6 +45,9 @@ struct CorrectedOperator {
   // first offset 0 (the base is the row's smallest source index).
   std::vector<Index> pattern_start;
   std::vector<Index> offset;
+  // Per pattern: 0 a corrected row, 1 degenerate (Shepard, plain gradient), 2 regularised by
+  // the gradient floor (method-notes eq. (3.2.6)).
+  std::vector<char> row_kind;
   std::vector<double> interp;
   std::vector<GradWeights> grad;
   // Runs of at most kMaxRun consecutive rows with one pattern and consecutive bases: for each
@@ -74,9 +77,13 @@ struct CorrectedOperator {
     return {base[static_cast<std::size_t>(a)], pattern_start[p], pattern_start[p + 1]};
   }
   Index source(const Row& r, Index k) const { return r.base + offset[static_cast<std::size_t>(k)]; }
+  /// Whether row a is degenerate or regularised (not a plain corrected row).
+  bool irregular(Index a) const {
+    return !row_kind.empty() && row_kind[static_cast<std::size_t>(pattern[static_cast<std::size_t>(a)])] != 0;
+  }
   std::size_t bytes() const {
     return (base.size() + pattern.size() + pattern_start.size() + offset.size() + run_start.size()) * sizeof(Index) +
-           interp.size() * sizeof(double) + grad.size() * sizeof(GradWeights);
+           row_kind.size() + interp.size() * sizeof(double) + grad.size() * sizeof(GradWeights);
   }
 };
 

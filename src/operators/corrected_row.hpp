@@ -104,6 +104,8 @@ class CorrectedRow {
   }
   /// Whether the last row evaluated was regularised by the gradient floor.
   bool regularised() const { return regularised_; }
+  /// Whether the last row evaluated was degenerate (Shepard and the plain gradient).
+  bool degenerate() const { return !ok_; }
 
   std::size_t size() const { return n_; }
   /// The sources of the row, in candidate order.

@@ -404,6 +404,7 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
   double b[Dim];
   for (int d = 0; d < Dim; ++d) b[d] = body[d];
   const double cd = c.damping;
+  const double simple_weight = m_.setup.simple_weight;
   const double t_half = c.t + 0.5 * dt;
   const CorrectedOperator<Dim>& op = m_.to_nodes;
   ParticleSet<Dim>& nodes = m_.nodes;
@@ -418,7 +419,8 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
   ViscoplasticSources<Dim>& src = *sources_;
   // The update of node i from the gradients of the stress points' state and their velocity
   // interpolated back (v_half, the material velocity at t^{n+1/2}).
-  auto update = [&](Index i, double(&grad_v)[Dim][Dim], double(&grad_s)[Dim][NS], double(&v_half)[Dim]) {
+  auto update = [&](Index i, double(&grad_v)[Dim][Dim], double(&grad_s)[Dim][NS], double(&v_half)[Dim],
+                    bool irregular_row) {
     const auto iu = static_cast<std::size_t>(i);
     if (volumetric_rate_ != nullptr) {
       // The stress points' divergence by the corrected gradient, before fix (a) replaces a
@@ -481,8 +483,16 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
     double* v = node_v[i];
     double* s = node_s[i];
     if constexpr (Velocity::kSimple) {
-      // The simple scheme (method-notes §2.3): from the stress points' velocity, half a step.
-      for (int d = 0; d < Dim; ++d) v[d] = damped_velocity(v_half[d], dv[d] + b[d], cd, 0.5 * dt);
+      // The simple scheme (method-notes §2.3): from the stress points' velocity, half a step;
+      // with a weight below 1, blended with V1's step 2 (eq. (2.3.2)).
+      const bool flagged = !m_.surface.row.empty() && m_.surface.row[iu] >= 0;
+      if (simple_weight == 1.0 || flagged || irregular_row) {
+        for (int d = 0; d < Dim; ++d) v[d] = damped_velocity(v_half[d], dv[d] + b[d], cd, 0.5 * dt);
+      } else {
+        for (int d = 0; d < Dim; ++d)
+          v[d] = simple_weight * damped_velocity(v_half[d], dv[d] + b[d], cd, 0.5 * dt) +
+                 (1.0 - simple_weight) * damped_velocity(v[d], dv[d] + b[d], cd, dt);
+      }
     } else {
       for (int d = 0; d < Dim; ++d) v[d] = damped_velocity(v[d], dv[d] + b[d], cd, dt);
     }
@@ -513,10 +523,10 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
       const OnTheFlySources<Dim> from{
           candidates,  nodes.position, mo.stress_point_position.data(), mo.stress_point_volume.data(),
           sp_v.data(), sp_s.data()};
-      const RowCounts counts =
-          rows_on_the_fly<Dim>(m_.policy, from, m_.kernel, mo.r2, m_.setup.gradient_floor,
-                               [&](const CorrectedRow<Dim>&, Index i, double(&v_half)[Dim], double(&grad_v)[Dim][Dim],
-                                   double(&)[NS], double(&grad_s)[Dim][NS]) { update(i, grad_v, grad_s, v_half); });
+      const RowCounts counts = rows_on_the_fly<Dim>(
+          m_.policy, from, m_.kernel, mo.r2, m_.setup.gradient_floor,
+          [&](const CorrectedRow<Dim>& row, Index i, double(&v_half)[Dim], double(&grad_v)[Dim][Dim], double(&)[NS],
+              double(&grad_s)[Dim][NS]) { update(i, grad_v, grad_s, v_half, row.regularised() || row.degenerate()); });
       m_.to_nodes.degenerate_rows = counts.degenerate;
       m_.to_nodes.regularised_rows = counts.regularised;
       m_.to_nodes.pair_count = counts.pairs;
@@ -551,7 +561,7 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
           // force: method-notes §0.3 item 8), and would make u drift.
           double v_half[Dim];
           for (int d = 0; d < Dim; ++d) v_half[d] = acc_v[0][sv + static_cast<std::size_t>(d)];
-          update(i, grad_v, grad_s, v_half);
+          update(i, grad_v, grad_s, v_half, Velocity::kSimple && simple_weight < 1.0 && op.irregular(i));
         }
       },
       exec::Schedule::even, nodes.size());

@@ -195,6 +195,21 @@ TEST(InputErrors, GradientFloorOutOfRange) {
   expect_error_at(o, line_of(text, "gradient_floor"), "solver.gradient_floor", {"[0, 0.5]"});
 }
 
+TEST(InputErrors, SimpleWeightOutOfRangeOrWithoutTheSimpleScheme) {
+  test::TempDir dir;
+  const std::string text = replace(kBase, "[time]", "[solver]\nversion = \"v2\"\nsimple_weight = 0\n[time]");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "simple_weight"), "solver.simple_weight", {"(0, 1]"});
+  const std::string tg =
+      replace(kBase, "[time]",
+              "[solver]\nversion = \"v2\"\nvelocity_update = \"taylor_galerkin\"\nsimple_weight = 0.5\n[time]");
+  const auto o2 = run_case_text(dir, tg);
+  expect_error_at(o2, line_of(tg, "simple_weight"), "solver.simple_weight", {"simple"});
+  const std::string v1 = replace(kBase, "[time]", "[solver]\nsimple_weight = 0.5\n[time]");
+  const auto o3 = run_case_text(dir, v1);
+  expect_error_at(o3, line_of(v1, "simple_weight"), "solver.simple_weight", {"v2"});
+}
+
 TEST(InputErrors, ShiftingNeedsV2WithTheDetectedSurface) {
   test::TempDir dir;
   const std::string text =

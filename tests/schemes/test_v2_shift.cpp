@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "../support/test_util.hpp"
+#include "../support/v2_block.hpp"
 #include "case/case_builder.hpp"
 #include "schemes/shift_stage.hpp"
 #include "schemes/simulation.hpp"
@@ -17,13 +18,7 @@ namespace rktsph {
 namespace {
 
 CaseBuilder<2> block(double jitter) {
-  CaseBuilder<2> b("v2 shift block");
-  b.spacing(0.1)
-      .origin(Vec<2>(-1.0, -1.0))
-      .block(Vec<2>(-1.0, -1.0), Vec<2>(1.0, 1.0))
-      .elastic(1.0e7, 0.3, 2000.0)
-      .scheme("v2")
-      .time(1.0, 0.5);
+  CaseBuilder<2> b = test::v2_block("v2 shift block");
   if (jitter > 0.0) b.jitter(jitter, 3);
   b.fix_velocity(Region<2>::plane(1, -1.0), {0, 1});
   return b;
