@@ -360,6 +360,17 @@ CaseReport validate_case08(const Options& opt, const std::string& dir) {
     const double worst = b.found ? std::max(std::abs(b.rising - 45.0), std::abs(b.falling - 45.0)) : NAN;
     Metric m = metric(tag + ": band angle at first formation, worst of the two diagonals, |theta - 45 deg|",
                       std::isfinite(worst) ? worst : 90.0, "<=", 7.0, "deg");
+    if (!m.pass()) {
+      m.known_deviation =
+          b.found ? fmt::format(
+                        "open: at {:.1f} % elongation the plastic strain of the last 0.1 s in the neck lies at "
+                        "{:.1f} and {:.1f} degrees to the axis ({} nodes): a diffuse neck across the bar, not "
+                        "two 45-degree bands. Not the viscosity: with gamma_f = 1000 1/s the neck is as diffuse. The "
+                        "cause is not established: the spacing, the diffusive simple second step, or the imperfection "
+                        "taken as a weaker block rather than a narrower section (docs/VALIDATION.md)",
+                        100.0 * b.elongation, b.rising, b.falling, b.particles)
+                  : "open: the deformation never concentrated in the neck: no band formed";
+    }
     rep.metrics.push_back(m);
   }
   {
@@ -369,9 +380,8 @@ CaseReport validate_case08(const Options& opt, const std::string& dir) {
       m.known_deviation =
           "open: in the neck the columns of nodes separate along the bar (stretch beyond the kernel's support) "
           "from about 16 % elongation: a numerical fracture. The gradient floor (solver.gradient_floor) keeps the "
-          "run going past it, so the bar reaches 30 % in two pieces; V1's step 2 (the case's velocity_update) "
-          "leaves fewer flags than the simple scheme, re-seeding and shifting (solver.reseed, solver.shift, off "
-          "in the case) fewer still but stopped the run sooner (docs/VALIDATION.md)";
+          "run going past it, so the bar reaches 30 % in two pieces; re-seeding and shifting (solver.reseed, "
+          "solver.shift, off in the case) left fewer flags but stopped the run sooner (docs/VALIDATION.md)";
     }
     rep.metrics.push_back(m);
   }
