@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <utility>
 
@@ -96,6 +97,21 @@ BandFit fit_band(const std::vector<double>& x, const std::vector<double>& y, con
   r.pair = std::abs(upper.first - whole.first) > 10.0 && std::abs(upper.first - lower.first) < 15.0;
   r.angle = r.pair ? 0.5 * (upper.first + lower.first) : whole.first;
   return r;
+}
+
+double band_contrast(const std::vector<double>& x, const std::vector<double>& y, const std::vector<double>& deps,
+                     double xc, double yc) {
+  double on = 0.0, off = 0.0;
+  int n_on = 0, n_off = 0;
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    const double dx = x[i] - xc, dy = y[i] - yc, r = std::hypot(dx, dy);
+    if (r <= 0.15 || r >= 0.45) continue;
+    const double to_diagonal = std::min(std::abs(dx - dy), std::abs(dx + dy)) / std::numbers::sqrt2;
+    if (to_diagonal < 0.1) on += deps[i], ++n_on;
+    if (to_diagonal > 0.2) off += deps[i], ++n_off;
+  }
+  if (n_on == 0 || n_off == 0 || !(off > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  return (on / n_on) / (off / n_off);
 }
 
 }  // namespace rktsph::validation

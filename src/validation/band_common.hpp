@@ -56,4 +56,13 @@ struct BandFit {
 BandFit fit_band(const std::vector<double>& x, const std::vector<double>& y, const std::vector<double>& eps,
                  double height, double margin, double xi, double yi, const std::vector<char>& outside = {});
 
+/// Whether a zone of plastic strain is two crossing 45-degree bands or one diffuse neck (Case 8):
+/// the mean increment `deps` of the points within 0.1 m of the two 45-degree diagonals through
+/// (xc, yc), over that of the points more than 0.2 m from both, all at 0.15-0.45 m from the
+/// centre (inside a 1 m bar's half width). Two bands give a ratio well above 1, a diffuse zone
+/// about 1 (though the diagonal fit of its quadrants reads 45 degrees when the zone is as wide
+/// as the bar). NaN when either set is empty.
+double band_contrast(const std::vector<double>& x, const std::vector<double>& y, const std::vector<double>& deps,
+                     double xc, double yc);
+
 }  // namespace rktsph::validation

@@ -50,6 +50,7 @@ struct BandMeasure {
   bool found = false;
   double t = 0.0, elongation = 0.0;
   double rising = NAN, falling = NAN;  // degrees to the bar axis of the two diagonal pairs
+  double contrast = NAN;               // on the diagonals / between them (band_contrast)
   int particles = 0;
   std::vector<double> x, y, deps;
   std::vector<char> in_cloud;
@@ -250,6 +251,7 @@ BarRun run_bar(const std::string& case_file, double dx) {
         yc /= b.particles;
         b.rising = angle_about(b.x, b.y, b.in_cloud, xc, yc, +1);
         b.falling = angle_about(b.x, b.y, b.in_cloud, xc, yc, -1);
+        b.contrast = band_contrast(b.x, b.y, b.deps, xc, yc);
       }
       eps_before.swap(eps_last);
       for (std::size_t i = 0; i < nn; ++i) eps_last[i] = eps(at(i));
@@ -364,15 +366,19 @@ CaseReport validate_case08(const Options& opt, const std::string& dir) {
       m.known_deviation =
           b.found ? fmt::format(
                         "open: at {:.1f} % elongation the plastic strain of the last 0.1 s in the neck lies at "
-                        "{:.1f} and {:.1f} degrees to the axis ({} nodes): a diffuse neck across the bar, not "
-                        "two 45-degree bands. Not the viscosity: with gamma_f = 1000 1/s the neck is as diffuse. The "
+                        "{:.1f} and {:.1f} degrees to the axis ({} nodes; band contrast {:.2f}): a diffuse neck across "
+                        "the bar, not two 45-degree bands. Not the viscosity: with gamma_f = 1000 1/s the neck is as "
+                        "diffuse. The "
                         "cause is not established: the spacing, the diffusive simple second step, or the imperfection "
                         "taken as a weaker block rather than a narrower section (docs/VALIDATION.md)",
-                        100.0 * b.elongation, b.rising, b.falling, b.particles)
+                        100.0 * b.elongation, b.rising, b.falling, b.particles, b.contrast)
                   : "open: the deformation never concentrated in the neck: no band formed";
     }
     rep.metrics.push_back(m);
   }
+  rep.metrics.push_back(metric(tag + ": band contrast, plastic strain increment on the two diagonals / between them "
+                                     "(about 1: one diffuse zone, no bands)",
+                               r.band.contrast, "", 0.0, ""));
   {
     Metric m = metric(tag + ": nodes inside the bar flagged as free surface at the end (gaps)",
                       r.interior_surface_nodes, "<=", 0.0, "");

@@ -4,6 +4,7 @@
 // 50 % threshold sees only the imperfection, as the cases' former measure did.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <vector>
@@ -48,6 +49,29 @@ TEST(BandFit, TheImperfectionOutsideTheBandRegionLeavesTheArms) {
       EXPECT_EQ(arms.in_band[i], 0) << "node " << i;
     }
   }
+}
+
+// Case 8's band contrast: on a 4 m x 1 m bar at 0.025 m, two crossing 45-degree bands 0.15 m wide
+// through the centre against one diffuse neck one bar width wide, whose quadrants' diagonal fit
+// would read 45 degrees too.
+TEST(BandContrast, TellsTwoCrossingBandsFromADiffuseNeck) {
+  const double xc = 2.0, yc = 0.5;
+  std::vector<double> x, y, bands, neck;
+  for (double px = 0.0; px <= 4.0 + 1e-9; px += 0.025) {
+    for (double py = 0.0; py <= 1.0 + 1e-9; py += 0.025) {
+      x.push_back(px);
+      y.push_back(py);
+      const double dx = px - xc, dy = py - yc;
+      const double to_diagonal = std::min(std::abs(dx - dy), std::abs(dx + dy)) / std::numbers::sqrt2;
+      bands.push_back(std::abs(dx) <= 0.5 && to_diagonal <= 0.075 ? 0.02 : 0.001);
+      neck.push_back(0.02 * std::exp(-dx * dx / (2.0 * 0.3 * 0.3)));
+    }
+  }
+  const double c_bands = band_contrast(x, y, bands, xc, yc), c_neck = band_contrast(x, y, neck, xc, yc);
+  EXPECT_GT(c_bands, 5.0);
+  EXPECT_GT(c_neck, 0.8);
+  EXPECT_LT(c_neck, 1.2);
+  EXPECT_TRUE(std::isnan(band_contrast(x, y, std::vector<double>(x.size(), 0.0), xc, yc))) << "no strain: no ratio";
 }
 
 }  // namespace
