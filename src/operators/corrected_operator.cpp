@@ -278,7 +278,6 @@ CorrectedOperator<Dim> build_corrected_operator(const Relation<Dim>& relation, c
   op.pattern = std::move(pattern);
   op.pattern_start = std::move(all.start);
   op.offset = std::move(all.offset);
-  op.row_kind = all.flags;
   op.interp = std::move(all.interp);
   op.grad = std::move(all.grad);
   op.run_start.push_back(0);
@@ -296,6 +295,7 @@ CorrectedOperator<Dim> build_corrected_operator(const Relation<Dim>& relation, c
     if (all.flags[p] == 1) ++op.degenerate_rows;
     if (all.flags[p] == 2) ++op.regularised_rows;
   }
+  op.row_kind = std::move(all.flags);
   return op;
 }
 
@@ -346,9 +346,6 @@ void rebuild_corrected_operator(const Relation<Dim>& candidates, const std::vect
   op.grad.resize(pairs);
   // Pass 2: the weights, row by row (method-notes §3.2), in fixed blocks of rows.
   const Index nblocks = (nt + kBuildBlock - 1) / kBuildBlock;
-  // Degenerate rows are rare and counted from any thread (an integer sum: the same whatever the
-  // order). Not a thread_local: each worker would see its own, empty, copy.
-  std::atomic<Index> degenerate{0}, regularised{0};
   std::atomic<bool> mismatch{false};
   exec::particle_for(
       policy, nblocks,
@@ -358,15 +355,10 @@ void rebuild_corrected_operator(const Relation<Dim>& candidates, const std::vect
         const Index end = std::min(nt, (blk + 1) * kBuildBlock);
         for (Index a = blk * kBuildBlock; a < end; ++a) {
           const auto au = static_cast<std::size_t>(a);
-          if (!row.evaluate(candidates.row(a), targets[au], sources.position.data(), sources.volume.data(), kernel, r2,
-                            gradient_floor)) {
-            degenerate.fetch_add(1, std::memory_order_relaxed);
-            op.row_kind[au] = 1;
-          }
-          if (row.regularised()) {
-            regularised.fetch_add(1, std::memory_order_relaxed);
-            if (op.row_kind[au] == 0) op.row_kind[au] = 2;
-          }
+          // The row's kind as row_weights gives it for a stored build: degenerate before regularised.
+          const bool ok = row.evaluate(candidates.row(a), targets[au], sources.position.data(), sources.volume.data(),
+                                       kernel, r2, gradient_floor);
+          op.row_kind[au] = !ok ? 1 : row.regularised() ? 2 : 0;
           const auto k0 = static_cast<std::size_t>(op.pattern_start[au]);
           if (row.size() != static_cast<std::size_t>(op.pattern_start[au + 1]) - k0) {
             mismatch.store(true, std::memory_order_relaxed);
@@ -387,8 +379,8 @@ void rebuild_corrected_operator(const Relation<Dim>& candidates, const std::vect
   op.run_start.resize(static_cast<std::size_t>(nt) + 1);
   for (Index a = 0; a <= nt; ++a) op.run_start[static_cast<std::size_t>(a)] = a;
   op.pair_count = pairs;
-  op.degenerate_rows = degenerate.load();
-  op.regularised_rows = regularised.load();
+  op.degenerate_rows = static_cast<Index>(std::count(op.row_kind.begin(), op.row_kind.end(), 1));
+  op.regularised_rows = static_cast<Index>(std::count(op.row_kind.begin(), op.row_kind.end(), 2));
 }
 
 namespace {

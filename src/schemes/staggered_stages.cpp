@@ -70,8 +70,9 @@ RowCounts rows_on_the_fly(const exec::Threads& policy, const OnTheFlySources<Dim
           if (!row.evaluate(from.candidates.row(a), from.targets[static_cast<std::size_t>(a)], from.position,
                             from.volume, kernel, r2, gradient_floor)) {
             ++block_degenerate;
+          } else if (row.regularised()) {
+            ++block_regularised;  // counted as the stored operators count it: degenerate first
           }
-          if (row.regularised()) ++block_regularised;
           block_pairs += row.size();
           double out_v[Dim + 1][Dim], out_s[Dim + 1][NS];
           row.template apply<Dim, NS>(from.velocity, from.stress, out_v, out_s);

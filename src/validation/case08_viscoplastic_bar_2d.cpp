@@ -368,9 +368,8 @@ CaseReport validate_case08(const Options& opt, const std::string& dir) {
                         "open: at {:.1f} % elongation the plastic strain of the last 0.1 s in the neck lies at "
                         "{:.1f} and {:.1f} degrees to the axis ({} nodes; band contrast {:.2f}): a diffuse neck across "
                         "the bar, not two 45-degree bands. Not the viscosity: with gamma_f = 1000 1/s the neck is as "
-                        "diffuse. The "
-                        "cause is not established: the spacing, the diffusive simple second step, or the imperfection "
-                        "taken as a weaker block rather than a narrower section (docs/VALIDATION.md)",
+                        "diffuse. The cause is not established: the spacing, the diffusive simple second step, or "
+                        "the imperfection taken as a weaker block rather than a narrower section (docs/VALIDATION.md)",
                         100.0 * b.elongation, b.rising, b.falling, b.particles, b.contrast)
                   : "open: the deformation never concentrated in the neck: no band formed";
     }
