@@ -333,6 +333,14 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
       s->require(c.version == "v2" && c.simple_velocity, "simple_weight",
                  "applies to V2's simple scheme (solver.version = \"v2\", velocity_update = \"simple\")");
     }
+    c.simple_stress_weight = s->number("simple_stress_weight", 0.0);
+    s->require(c.simple_stress_weight >= 0.0 && c.simple_stress_weight <= 1.0, "simple_stress_weight",
+               fmt::format("must lie in [0, 1] (the stress points' share of the nodal stress update; "
+                           "0: the nodes' own step), got {}",
+                           c.simple_stress_weight));
+    if (s->has("simple_stress_weight")) {
+      s->require(c.version == "v2", "simple_stress_weight", "applies to V2 (solver.version = \"v2\")");
+    }
     c.gradient_floor = s->number("gradient_floor", default_gradient_floor<Dim>(c.version));
     s->require(c.gradient_floor >= 0.0 && c.gradient_floor <= 0.5, "gradient_floor",
                fmt::format("must lie in [0, 0.5] (the smallest eigenvalue allowed for a row's gradient "

@@ -261,6 +261,11 @@ struct CaseSetup {
   /// V2, simple scheme: the weight of the simple scheme's velocity in the nodal update, the
   /// rest V1's step 2 (method-notes eq. (2.3.2); solver.simple_weight). 1: the simple scheme.
   double simple_weight = 1.0;
+  /// V2: the weight of the stress points' stress in the nodal stress update, the rest the nodes'
+  /// own full step (method-notes eq. (2.3.3); solver.simple_stress_weight). 0: the nodes
+  /// integrate their own stress; a positive weight removes the nodal stress modes the stress
+  /// points do not see at (1 - weight) a step.
+  double simple_stress_weight = 0.0;
   /// The corrected operators' gradient floor (method-notes eq. (3.2.6); solver.gradient_floor):
   /// a row whose gradient renormalisation matrix has an eigenvalue below it (a thin sheet of
   /// particles, a lone particle) is regularised. The reader's default: default_gradient_floor.

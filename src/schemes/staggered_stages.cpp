@@ -406,6 +406,7 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
   for (int d = 0; d < Dim; ++d) b[d] = body[d];
   const double cd = c.damping;
   const double simple_weight = m_.setup.simple_weight;
+  const double stress_weight = m_.setup.simple_stress_weight;
   const double t_half = c.t + 0.5 * dt;
   const CorrectedOperator<Dim>& op = m_.to_nodes;
   ParticleSet<Dim>& nodes = m_.nodes;
@@ -421,7 +422,7 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
   // The update of node i from the gradients of the stress points' state and their velocity
   // interpolated back (v_half, the material velocity at t^{n+1/2}).
   auto update = [&](Index i, double(&grad_v)[Dim][Dim], double(&grad_s)[Dim][NS], double(&v_half)[Dim],
-                    bool irregular_row) {
+                    bool irregular_row, const double(&s_half)[NS]) {
     const auto iu = static_cast<std::size_t>(i);
     if (volumetric_rate_ != nullptr) {
       // The stress points' divergence by the corrected gradient, before fix (a) replaces a
@@ -512,6 +513,19 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
       }
     }
     for (int k = 0; k < NS; ++k) s[k] += dt * dsig[k];
+    if (stress_weight > 0.0) {
+      // eq. (2.3.3): blended with the simple scheme's stress, the stress points' stress at
+      // t^{n+1/2} interpolated to the node, rotated over the second half step and advanced by
+      // half a step's flux; the source then acts on the blend (its start moved with it).
+      double simple[NS];
+      for (int k = 0; k < NS; ++k) simple[k] = s_half[k];
+      if constexpr (Motion::kMoving) jaumann_rotate<Dim>(grad_v, 0.5 * dt, simple);
+      for (int k = 0; k < NS; ++k) {
+        const double blended = s[k] + stress_weight * (simple[k] + 0.5 * dt * dsig[k] - s[k]);
+        if (sources) src.sigma_start(i)[k] += blended - s[k];
+        s[k] = blended;
+      }
+    }
     // Displacement by the midpoint rule (method-notes §0.3 item 8).
     for (int d = 0; d < Dim; ++d) node_u(i, d) += dt * v_half[d];
   };
@@ -524,10 +538,12 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
       const OnTheFlySources<Dim> from{
           candidates,  nodes.position, mo.stress_point_position.data(), mo.stress_point_volume.data(),
           sp_v.data(), sp_s.data()};
-      const RowCounts counts = rows_on_the_fly<Dim>(
-          m_.policy, from, m_.kernel, mo.r2, m_.setup.gradient_floor,
-          [&](const CorrectedRow<Dim>& row, Index i, double(&v_half)[Dim], double(&grad_v)[Dim][Dim], double(&)[NS],
-              double(&grad_s)[Dim][NS]) { update(i, grad_v, grad_s, v_half, row.regularised() || row.degenerate()); });
+      const RowCounts counts =
+          rows_on_the_fly<Dim>(m_.policy, from, m_.kernel, mo.r2, m_.setup.gradient_floor,
+                               [&](const CorrectedRow<Dim>& row, Index i, double(&v_half)[Dim],
+                                   double(&grad_v)[Dim][Dim], double(&s_half)[NS], double(&grad_s)[Dim][NS]) {
+                                 update(i, grad_v, grad_s, v_half, row.regularised() || row.degenerate(), s_half);
+                               });
       m_.to_nodes.degenerate_rows = counts.degenerate;
       m_.to_nodes.regularised_rows = counts.regularised;
       m_.to_nodes.pair_count = counts.pairs;
@@ -562,7 +578,10 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
           // force: method-notes §0.3 item 8), and would make u drift.
           double v_half[Dim];
           for (int d = 0; d < Dim; ++d) v_half[d] = acc_v[0][sv + static_cast<std::size_t>(d)];
-          update(i, grad_v, grad_s, v_half, Velocity::kSimple && simple_weight < 1.0 && op.irregular(i));
+          // The stress points' stress at t^{n+1/2} at the node (eq. (2.3.3); unused at weight 0).
+          double s_half[NS];
+          for (int k = 0; k < NS; ++k) s_half[k] = acc_s[0][ss + static_cast<std::size_t>(k)];
+          update(i, grad_v, grad_s, v_half, Velocity::kSimple && simple_weight < 1.0 && op.irregular(i), s_half);
         }
       },
       exec::Schedule::even, nodes.size());

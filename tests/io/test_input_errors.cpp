@@ -210,6 +210,16 @@ TEST(InputErrors, SimpleWeightOutOfRangeOrWithoutTheSimpleScheme) {
   expect_error_at(o3, line_of(v1, "simple_weight"), "solver.simple_weight", {"v2"});
 }
 
+TEST(InputErrors, SimpleStressWeightOutOfRangeOrOutsideV2) {
+  test::TempDir dir;
+  const std::string text = replace(kBase, "[time]", "[solver]\nversion = \"v2\"\nsimple_stress_weight = 1.5\n[time]");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "simple_stress_weight"), "solver.simple_stress_weight", {"[0, 1]"});
+  const std::string v1 = replace(kBase, "[time]", "[solver]\nsimple_stress_weight = 0.2\n[time]");
+  const auto o2 = run_case_text(dir, v1);
+  expect_error_at(o2, line_of(v1, "simple_stress_weight"), "solver.simple_stress_weight", {"v2"});
+}
+
 TEST(InputErrors, ShiftingNeedsV2WithTheDetectedSurface) {
   test::TempDir dir;
   const std::string text =

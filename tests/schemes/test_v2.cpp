@@ -9,6 +9,7 @@
 #include <cstring>
 #include <numbers>
 #include <random>
+#include <utility>
 
 #include "../support/test_util.hpp"
 #include "case/case_builder.hpp"
@@ -179,13 +180,14 @@ TEST(V2, SinCosSeriesAgreesWithLibm) {
 // viscoplastic block on a fixed base, with its free surface detected, ends in the same state
 // both ways to round-off, the history variables (interpolated with the value row alone) too.
 // With the simple scheme's weight below 1 (eq. (2.3.2)) as well: the stored rows' kinds (corrected,
-// regularised, degenerate) choose the update as the rows evaluated on the fly do.
-class V2OnTheFly : public ::testing::TestWithParam<double> {};
+// regularised, degenerate) choose the update as the rows evaluated on the fly do; and with the
+// stress points' share of the nodal stress (eq. (2.3.3)), whose interpolated stress both paths give.
+class V2OnTheFly : public ::testing::TestWithParam<std::pair<double, double>> {};
 
 TEST_P(V2OnTheFly, OperatorsOnTheFlyAgreeWithStoredOperators) {
   const test::ThreadCount threads(1);
-  const double weight = GetParam();
-  auto run = [weight](bool on_the_fly) {
+  const auto [weight, stress_weight] = GetParam();
+  auto run = [weight, stress_weight](bool on_the_fly) {
     VonMisesParameters vm;
     vm.elastic = ElasticConstants::from_E_nu(1.0e7, 0.3, 2000.0);
     vm.yield_stress = 2.0e4;
@@ -206,6 +208,7 @@ TEST_P(V2OnTheFly, OperatorsOnTheFlyAgreeWithStoredOperators) {
     CaseSetup<2> c = b.build();
     c.operators_on_the_fly = on_the_fly;
     c.simple_weight = weight;
+    c.simple_stress_weight = stress_weight;
     auto sim = std::make_unique<Simulation<2>>(c);
     while (sim->time() < 0.2 - 1e-12) sim->step();
     return sim;
@@ -247,7 +250,8 @@ TEST_P(V2OnTheFly, OperatorsOnTheFlyAgreeWithStoredOperators) {
   EXPECT_LT(dx, 1e-12);
 }
 
-INSTANTIATE_TEST_SUITE_P(SimpleWeight, V2OnTheFly, ::testing::Values(1.0, 0.5));
+INSTANTIATE_TEST_SUITE_P(SimpleWeight, V2OnTheFly,
+                         ::testing::Values(std::pair{1.0, 0.0}, std::pair{0.5, 0.0}, std::pair{1.0, 0.2}));
 
 // The Verlet lists (searched with a skin, kept while the particles move less than half of it)
 // give the operators of a fresh search at the current positions, bit for bit.
