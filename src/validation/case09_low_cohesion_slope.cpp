@@ -263,7 +263,10 @@ CaseReport validate_case09(const Options& opt, const std::string& dir) {
       "detected surface follows those gaps), and stops high and short (front {:.1f} m against x_f = {:.1f} m). The "
       "simple scheme's averaging of the nodal velocity (method-notes §2.3) acts as a viscosity of order rho c_p dx "
       "that a column whose cohesion is 1/50 of gamma H cannot overcome (a lower solver.simple_weight, eq. (2.3.2), "
-      "lengthens the run-out with the viscosity but stops below 0.5). A particle behind a body at a record "
+      "lengthens the run-out with the viscosity but stops below 0.5, from a growing nodal stress mode; blending the "
+      "nodal stress with the stress points', solver.simple_stress_weight, eq. (2.3.3), carries those runs to their "
+      "end at dx = 0.25 m, run-out up to 0.79 x_f, not at 0.125 m, and costs static strength elsewhere). A particle "
+      "behind a body at a record "
       "(one, once, in the quick run of 2026-12-05) is not located yet",
       front, xf);
   auto push = [&](Metric m) {
