@@ -2,9 +2,13 @@
 // origin on a 0.1 m lattice, free faces, to 1 s at C = 0.5.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <string>
+#include <vector>
 
 #include "case/case_builder.hpp"
+#include "schemes/simulation.hpp"
 
 namespace rktsph::test {
 
@@ -17,6 +21,35 @@ inline CaseBuilder<2> v2_block(const std::string& name) {
       .scheme("v2")
       .time(1.0, 0.5);
   return b;
+}
+
+/// The rigid-rotation check of the V2 Jaumann tests: the initial uniform stress (sxx, syy, szz,
+/// sxy) = (-1e4, -3e4, -2e4, 5e3) Pa rotated counter-clockwise by theta, R sigma R^T, against the
+/// nodes that started within `half_width` of the centre (by id: V2 sorts its nodes as they
+/// move). Returns the largest difference, Pa, and the count of nodes checked.
+struct RotationCheck {
+  double worst = 0.0;
+  int nodes = 0;
+};
+inline RotationCheck rotated_stress_error(const Simulation<2>& sim, const std::vector<Vec<2>>& start, double theta,
+                                          double half_width) {
+  const double a = -1.0e4, d = -3.0e4, b = 5.0e3, zz = -2.0e4;
+  const double c = std::cos(theta), s = std::sin(theta);
+  const double xx = c * c * a - 2.0 * c * s * b + s * s * d;
+  const double yy = s * s * a + 2.0 * c * s * b + c * c * d;
+  const double xy = c * s * (a - d) + (c * c - s * s) * b;
+  RotationCheck r;
+  const auto stress = sim.node_stress();
+  const std::vector<Index> at = sim.nodes_by_id();
+  for (std::size_t k = 0; k < start.size(); ++k) {
+    if (std::abs(start[k][0]) > half_width || std::abs(start[k][1]) > half_width) continue;
+    const Index i = at[k];
+    ++r.nodes;
+    r.worst =
+        std::max({r.worst, std::abs(stress(i, StressComponent::xx) - xx), std::abs(stress(i, StressComponent::yy) - yy),
+                  std::abs(stress(i, StressComponent::xy) - xy), std::abs(stress(i, StressComponent::zz) - zz)});
+  }
+  return r;
 }
 
 }  // namespace rktsph::test
