@@ -475,6 +475,8 @@ CorrectedOperator<Dim> quadratic_exact_gradient(const CorrectedOperator<Dim>& op
     const Index begin = op.pattern_start[static_cast<std::size_t>(p)],
                 end = op.pattern_start[static_cast<std::size_t>(p) + 1];
     moved_to[static_cast<std::size_t>(p)] = out.patterns();
+    // The copy keeps its pattern's kind (row_kind has one entry per pattern).
+    if (!op.row_kind.empty()) out.row_kind.push_back(op.row_kind[static_cast<std::size_t>(p)]);
     for (Index k = begin; k < end; ++k) {
       out.offset.push_back(op.offset[static_cast<std::size_t>(k)]);
       out.interp.push_back(op.interp[static_cast<std::size_t>(k)]);

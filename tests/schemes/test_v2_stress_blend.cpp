@@ -24,12 +24,7 @@ std::vector<double> interior_stress_checkerboard(double beta, int steps) {
   CaseSetup<2> c = test::v2_block("v2 block, nodal stress checkerboard").build();
   c.simple_stress_weight = beta;
   Simulation<2> sim(c);
-  std::vector<double> sign(sim.nodes().position.size());
-  for (std::size_t i = 0; i < sign.size(); ++i) {
-    const Vec<2>& p = sim.nodes().position[i];
-    const long ix = std::lround((p[0] + 1.0) / 0.1), iy = std::lround((p[1] + 1.0) / 0.1);
-    sign[i] = (ix + iy) % 2 == 0 ? 1.0 : -1.0;
-  }
+  const std::vector<double> sign = test::lattice_checkerboard(sim.nodes().position);
   auto s = sim.mutable_node_stress();
   for (std::size_t i = 0; i < sign.size(); ++i) s(i, 0) = sign[i] * 1.0e3;
   const std::vector<Vec<2>> start = sim.nodes().position;

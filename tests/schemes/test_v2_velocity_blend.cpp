@@ -30,12 +30,7 @@ CaseSetup<2> free_block(double weight) {
 // stays a lattice).
 std::vector<double> interior_checkerboard(double weight, int steps) {
   Simulation<2> sim(free_block(weight));
-  std::vector<double> sign(sim.nodes().position.size());
-  for (std::size_t i = 0; i < sign.size(); ++i) {
-    const Vec<2>& p = sim.nodes().position[i];
-    const long ix = std::lround((p[0] + 1.0) / 0.1), iy = std::lround((p[1] + 1.0) / 0.1);
-    sign[i] = (ix + iy) % 2 == 0 ? 1.0 : -1.0;
-  }
+  const std::vector<double> sign = test::lattice_checkerboard(sim.nodes().position);
   auto v = sim.mutable_node_velocity();
   for (std::size_t i = 0; i < sign.size(); ++i) {
     v(i, 0) = sign[i] * 1e-6;

@@ -23,6 +23,17 @@ inline CaseBuilder<2> v2_block(const std::string& name) {
   return b;
 }
 
+/// +1 / -1 on the two colours of the test block's 0.1 m node lattice (positions from -1 m): the
+/// nodal checkerboard, which no stress point of the lattice sees.
+inline std::vector<double> lattice_checkerboard(const std::vector<Vec<2>>& position) {
+  std::vector<double> sign(position.size());
+  for (std::size_t i = 0; i < sign.size(); ++i) {
+    const long ix = std::lround((position[i][0] + 1.0) / 0.1), iy = std::lround((position[i][1] + 1.0) / 0.1);
+    sign[i] = (ix + iy) % 2 == 0 ? 1.0 : -1.0;
+  }
+  return sign;
+}
+
 /// The rigid-rotation check of the V2 Jaumann tests: the initial uniform stress (sxx, syy, szz,
 /// sxy) = (-1e4, -3e4, -2e4, 5e3) Pa rotated counter-clockwise by theta, R sigma R^T, against the
 /// nodes that started within `half_width` of the centre (by id: V2 sorts its nodes as they
