@@ -341,6 +341,14 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     if (s->has("simple_stress_weight")) {
       s->require(c.version == "v2", "simple_stress_weight", "applies to V2 (solver.version = \"v2\")");
     }
+    c.stress_filter = s->number("stress_filter", 0.0);
+    s->require(
+        c.stress_filter >= 0.0 && c.stress_filter <= 1.0, "stress_filter",
+        fmt::format("must lie in [0, 1] (the fourth-order filter's strength on the nodal stress; 0: off), got {}",
+                    c.stress_filter));
+    if (s->has("stress_filter")) {
+      s->require(c.version == "v2", "stress_filter", "applies to V2 (solver.version = \"v2\")");
+    }
     c.gradient_floor = s->number("gradient_floor", default_gradient_floor<Dim>(c.version));
     s->require(c.gradient_floor >= 0.0 && c.gradient_floor <= 0.5, "gradient_floor",
                fmt::format("must lie in [0, 0.5] (the smallest eigenvalue allowed for a row's gradient "
@@ -437,11 +445,14 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     const bool filtered = !c.simple_velocity && c.filter;
     const std::string operators = s->string("operators", "auto");
     if (operators == "auto") {
-      c.operators_on_the_fly = !filtered;
+      c.operators_on_the_fly = !filtered && c.stress_filter == 0.0;
     } else if (operators == "on_the_fly") {
       s->require(!filtered, "operators",
                  "\"on_the_fly\" cannot serve V1's velocity filter, which applies the stored operators "
                  "(velocity_update = \"taylor_galerkin\" with filter = true): use \"stored\" or \"auto\"");
+      s->require(c.stress_filter == 0.0, "operators",
+                 "\"on_the_fly\" cannot serve the stress filter (solver.stress_filter > 0), which applies the "
+                 "stored operators: use \"stored\" or \"auto\"");
       c.operators_on_the_fly = true;
     } else if (operators == "stored") {
       c.operators_on_the_fly = false;

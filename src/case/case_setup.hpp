@@ -266,6 +266,10 @@ struct CaseSetup {
   /// integrate their own stress; a positive weight removes the nodal stress modes the stress
   /// points do not see at (1 - weight) a step.
   double simple_stress_weight = 0.0;
+  /// V2: the strength eps of the fourth-order filter on the nodal stress, sigma <- sigma - eps
+  /// (I - P_NE P_EN)^2 sigma after step 2 (method-notes eq. (2.3.4); solver.stress_filter).
+  /// 0: off. It removes the nodal stress mode at eps a step and leaves linear fields exactly.
+  double stress_filter = 0.0;
   /// The corrected operators' gradient floor (method-notes eq. (3.2.6); solver.gradient_floor):
   /// a row whose gradient renormalisation matrix has an eigenvalue below it (a thin sheet of
   /// particles, a lone particle) is regularised. The reader's default: default_gradient_floor.

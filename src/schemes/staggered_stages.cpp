@@ -598,7 +598,73 @@ void NodeFullStep<Dim, Motion, Velocity>::load(const io::StateArchive& a, const 
   sources_->set_max_substeps(static_cast<long>(a.integer(prefix + "max_source_substeps")));
 }
 
-// ---- velocity filter
+// ---- checkerboard filters
+
+namespace {
+
+// f <- f - eps (I - P_NE P_EN)^2 f on the nodal field f of NC values a node (method-notes §0.3
+// item 3, eq. (2.3.4)): P_EN interpolates nodes to stress points, P_NE back. The mode that the
+// stress points cannot see (P_EN f = 0) loses eps of itself; a linear field, which both
+// interpolations reproduce, is left exactly; a smooth one changes at O(eps h^4).
+template <int Dim, int NC>
+void filter_nodal_checkerboard(StaggeredModel<Dim>& m, double* field, double eps, std::vector<double>& at_sp,
+                               std::vector<double>& at_nodes) {
+  const Index ne = m.stress_points.size();
+  const Index nn = m.nodes.size();
+  // Re-seeded stress points (V2) change their count; otherwise this never allocates.
+  if (at_sp.size() != static_cast<std::size_t>(ne) * NC) at_sp.assign(static_cast<std::size_t>(ne) * NC, 0.0);
+  if (at_nodes.size() != static_cast<std::size_t>(nn) * NC) at_nodes.assign(static_cast<std::size_t>(nn) * NC, 0.0);
+  const CorrectedOperator<Dim>& en = m.to_stress_points;
+  const CorrectedOperator<Dim>& ne_op = m.to_nodes;
+  FieldView<double, NC> filter_sp(at_sp.data(), ne, NC);
+  FieldView<double, NC> filter_node(at_nodes.data(), nn, NC);
+  FieldView<double, NC> f(field, nn, NC);
+  auto to_stress_points = [&](const double* node_field) {
+    // By runs (run_sums): the vector loop over a run's contiguous sources.
+    exec::particle_for(
+        m.policy, en.runs(),
+        [&](Index r) {
+          double acc[CorrectedOperator<Dim>::kMaxRun * NC];
+          double* sums[1] = {acc};
+          const Index e0 = en.run_start[static_cast<std::size_t>(r)],
+                      e1 = en.run_start[static_cast<std::size_t>(r) + 1];
+          const auto e0u = static_cast<std::size_t>(e0);
+          const auto p = static_cast<std::size_t>(en.pattern[e0u]);
+          run_sums<1, 16>(
+              node_field + static_cast<std::size_t>(en.base[e0u]) * NC, NC, static_cast<std::size_t>(e1 - e0) * NC,
+              en.offset.data(), en.pattern_start[p], en.pattern_start[p + 1],
+              [&](Index k, double* w) { w[0] = en.interp[static_cast<std::size_t>(k)]; }, sums);
+          for (Index e = e0; e < e1; ++e) {
+            for (int c = 0; c < NC; ++c)
+              filter_sp(e, c) = acc[static_cast<std::size_t>(e - e0) * NC + static_cast<std::size_t>(c)];
+          }
+        },
+        exec::Schedule::even, ne);
+  };
+  auto back_to_nodes = [&](Index i, double* acc) {
+    for (int c = 0; c < NC; ++c) acc[c] = 0.0;
+    const auto row = ne_op.row(i);
+    for (Index k = row.begin; k < row.end; ++k) {
+      const double wk = ne_op.interp[static_cast<std::size_t>(k)];
+      const double* p = filter_sp[ne_op.source(row, k)];
+      for (int c = 0; c < NC; ++c) acc[c] += wk * p[c];
+    }
+  };
+  to_stress_points(field);
+  exec::particle_for(m.policy, nn, [&](Index i) {
+    double acc[NC];
+    back_to_nodes(i, acc);
+    for (int c = 0; c < NC; ++c) filter_node(i, c) = f(i, c) - acc[c];
+  });
+  to_stress_points(filter_node.data());
+  exec::particle_for(m.policy, nn, [&](Index i) {
+    double acc[NC];
+    back_to_nodes(i, acc);
+    for (int c = 0; c < NC; ++c) f(i, c) -= eps * (filter_node(i, c) - acc[c]);
+  });
+}
+
+}  // namespace
 
 template <int Dim>
 VelocityFilter<Dim>::VelocityFilter(StaggeredModel<Dim>& model, double strength)
@@ -609,61 +675,21 @@ VelocityFilter<Dim>::VelocityFilter(StaggeredModel<Dim>& model, double strength)
 
 template <int Dim>
 void VelocityFilter<Dim>::run(const StepContext&) {
-  const Index ne = m_.stress_points.size();
-  const Index nn = m_.nodes.size();
-  // Re-seeded stress points (V2) change their count; otherwise this never allocates.
-  if (at_stress_points_.size() != static_cast<std::size_t>(ne) * Dim) {
-    at_stress_points_.assign(static_cast<std::size_t>(ne) * Dim, 0.0);
-  }
-  const double eps = strength_;
-  const CorrectedOperator<Dim>& en = m_.to_stress_points;
-  const CorrectedOperator<Dim>& ne_op = m_.to_nodes;
-  FieldView<double, Dim> filter_sp(at_stress_points_.data(), ne, Dim);
-  FieldView<double, Dim> filter_node(at_nodes_.data(), nn, Dim);
-  auto v = m_.nodes.view(m_.fields.velocity);
-  auto to_stress_points = [&](const double* node_field) {
-    // By runs (run_sums): the vector loop over a run's contiguous sources.
-    exec::particle_for(
-        m_.policy, en.runs(),
-        [&](Index r) {
-          double acc[CorrectedOperator<Dim>::kMaxRun * Dim];
-          double* sums[1] = {acc};
-          const Index e0 = en.run_start[static_cast<std::size_t>(r)],
-                      e1 = en.run_start[static_cast<std::size_t>(r) + 1];
-          const auto e0u = static_cast<std::size_t>(e0);
-          const auto p = static_cast<std::size_t>(en.pattern[e0u]);
-          run_sums<1, 16>(
-              node_field + static_cast<std::size_t>(en.base[e0u]) * Dim, Dim, static_cast<std::size_t>(e1 - e0) * Dim,
-              en.offset.data(), en.pattern_start[p], en.pattern_start[p + 1],
-              [&](Index k, double* w) { w[0] = en.interp[static_cast<std::size_t>(k)]; }, sums);
-          for (Index e = e0; e < e1; ++e) {
-            for (int d = 0; d < Dim; ++d)
-              filter_sp(e, d) = acc[static_cast<std::size_t>(e - e0) * Dim + static_cast<std::size_t>(d)];
-          }
-        },
-        exec::Schedule::even, ne);
-  };
-  auto back_to_nodes = [&](Index i, double* acc) {
-    for (int d = 0; d < Dim; ++d) acc[d] = 0.0;
-    const auto row = ne_op.row(i);
-    for (Index k = row.begin; k < row.end; ++k) {
-      const double wk = ne_op.interp[static_cast<std::size_t>(k)];
-      const double* p = filter_sp[ne_op.source(row, k)];
-      for (int d = 0; d < Dim; ++d) acc[d] += wk * p[d];
-    }
-  };
-  to_stress_points(v.data());
-  exec::particle_for(m_.policy, nn, [&](Index i) {
-    double acc[Dim];
-    back_to_nodes(i, acc);
-    for (int d = 0; d < Dim; ++d) filter_node(i, d) = v(i, d) - acc[d];
-  });
-  to_stress_points(filter_node.data());
-  exec::particle_for(m_.policy, nn, [&](Index i) {
-    double acc[Dim];
-    back_to_nodes(i, acc);
-    for (int d = 0; d < Dim; ++d) v(i, d) -= eps * (filter_node(i, d) - acc[d]);
-  });
+  filter_nodal_checkerboard<Dim, Dim>(m_, m_.nodes.view(m_.fields.velocity).data(), strength_, at_stress_points_,
+                                      at_nodes_);
+}
+
+template <int Dim>
+StressFilter<Dim>::StressFilter(StaggeredModel<Dim>& model, double strength)
+    : m_(model),
+      strength_(strength),
+      at_stress_points_(static_cast<std::size_t>(model.stress_points.size()) * NS, 0.0),
+      at_nodes_(static_cast<std::size_t>(model.nodes.size()) * NS, 0.0) {}
+
+template <int Dim>
+void StressFilter<Dim>::run(const StepContext&) {
+  filter_nodal_checkerboard<Dim, NS>(m_, m_.nodes.view(m_.fields.stress).data(), strength_, at_stress_points_,
+                                     at_nodes_);
 }
 
 #define RKTSPH_INSTANTIATE(D)                                                 \
@@ -674,7 +700,8 @@ void VelocityFilter<Dim>::run(const StepContext&) {
   template class NodeFullStep<D>;                                             \
   template class NodeFullStep<D, MovingParticles, SimpleVelocity>;            \
   template class NodeFullStep<D, MovingParticles, TaylorGalerkinVelocity>;    \
-  template class VelocityFilter<D>;
+  template class VelocityFilter<D>;                                           \
+  template class StressFilter<D>;
 RKTSPH_INSTANTIATE(1)
 RKTSPH_INSTANTIATE(2)
 RKTSPH_INSTANTIATE(3)

@@ -4,6 +4,7 @@
 //   NodeFullStep         step 2: stress points -> nodes, t^n -> t^{n+1}, and the displacement
 //   ApplyConstraints     prescribed components at t^{n+1}
 //   VelocityFilter       the fourth-order velocity filter (method-notes §0.3 item 3)
+//   StressFilter         the same filter on the nodal stress (V2, method-notes eq. (2.3.4))
 // Viscoplastic sources are integrated by Runge–Kutta inside steps 1 and 2 (ViscoplasticSources).
 // The time loop allocates nothing: every work array is sized when a stage is made.
 #include <memory>
@@ -146,6 +147,24 @@ class VelocityFilter final : public Stage {
   StaggeredModel<Dim>& m_;
   double strength_;
   std::vector<double> at_stress_points_, at_nodes_;  // Dim values per particle
+};
+
+/// sigma <- sigma - eps (I - P_NE P_EN)^2 sigma on the nodal stress (V2, method-notes eq.
+/// (2.3.4)): the same fourth-order filter for the nodal stress mode that the stress points
+/// cannot see; exact on linear fields, objective (it commutes with a uniform rotation).
+template <int Dim>
+class StressFilter final : public Stage {
+ public:
+  static constexpr int NS = kStressComponents<Dim>;
+  StressFilter(StaggeredModel<Dim>& model, double strength);
+  std::string_view name() const override { return "stress_filter"; }
+  void run(const StepContext& context) override;
+  std::size_t scratch_bytes() const override { return (at_stress_points_.size() + at_nodes_.size()) * sizeof(double); }
+
+ private:
+  StaggeredModel<Dim>& m_;
+  double strength_;
+  std::vector<double> at_stress_points_, at_nodes_;  // NS values per particle
 };
 
 }  // namespace rktsph

@@ -7,14 +7,16 @@
 //   2. nodes: the stress by step 2 with the Jaumann rotation, the velocity by the simple
 //      scheme (solver.velocity_update = "simple", default) or V1's step 2
 //      ("taylor_galerkin"), continuity, positions and displacements;
-//   3. prescribed components at t^{n+1} (and V1's velocity filter with the Taylor-Galerkin
-//      update only: the simple scheme has no nodal mode to filter); the free surface made
-//      traction-free again on the stress at t^{n+1}.
+//   3. the nodal stress filter when solver.stress_filter > 0 (method-notes eq. (2.3.4));
+//      prescribed components at t^{n+1} (and V1's velocity filter with the Taylor-Galerkin
+//      update only: the simple scheme has no nodal velocity mode to filter); the free
+//      surface made traction-free again on the stress at t^{n+1}.
 // With rigid bodies (2D, method-notes §4.5): the contact set at t^n after step 0 (its nodes are
 // never flagged as free surface), the contact constraints, projections and reactions after 3.
 #include <chrono>
 #include <functional>
 #include <memory>
+#include <stdexcept>
 #include <utility>
 
 #include "schemes/deactivate_stage.hpp"
@@ -78,13 +80,22 @@ std::unique_ptr<Scheme> make_v2_scheme(StaggeredModel<Dim>& model) {
   MovingOperators<Dim>* moving = &rebuilt.moving_operators();
   scheme->add(std::make_unique<StressPointHalfStep<Dim, NoPressureGradient, MovingParticles>>(model, sources))
       .set_moving_operators(moving);
+  // The nodal stress filter (eq. (2.3.4)) on step 2's stress, source included, before the
+  // prescribed components and the traction-free rotation put theirs back.
+  auto add_stress_filter = [&] {
+    if (model.setup.operators_on_the_fly)
+      throw std::logic_error("v2 scheme: the stress filter needs the stored operators (the reader chooses them)");
+    scheme->add(std::make_unique<StressFilter<Dim>>(model, model.setup.stress_filter));
+  };
   if (model.setup.simple_velocity) {
     scheme->add(std::make_unique<NodeFullStep<Dim, MovingParticles, SimpleVelocity>>(model, sources))
         .set_moving_operators(moving);
+    if (model.setup.stress_filter > 0.0) add_stress_filter();
     scheme->add(std::make_unique<ApplyConstraints<Dim>>(model));
   } else {
     scheme->add(std::make_unique<NodeFullStep<Dim, MovingParticles, TaylorGalerkinVelocity>>(model, sources))
         .set_moving_operators(moving);
+    if (model.setup.stress_filter > 0.0) add_stress_filter();
     scheme->add(std::make_unique<ApplyConstraints<Dim>>(model));
     if (model.setup.filter) {
       scheme->add(std::make_unique<VelocityFilter<Dim>>(model, model.setup.filter_strength));

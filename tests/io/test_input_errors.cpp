@@ -220,6 +220,20 @@ TEST(InputErrors, SimpleStressWeightOutOfRangeOrOutsideV2) {
   expect_error_at(o2, line_of(v1, "simple_stress_weight"), "solver.simple_stress_weight", {"v2"});
 }
 
+TEST(InputErrors, StressFilterOutOfRangeOutsideV2OrOnTheFly) {
+  test::TempDir dir;
+  const std::string text = replace(kBase, "[time]", "[solver]\nversion = \"v2\"\nstress_filter = -0.1\n[time]");
+  const auto o = run_case_text(dir, text);
+  expect_error_at(o, line_of(text, "stress_filter"), "solver.stress_filter", {"[0, 1]"});
+  const std::string v1 = replace(kBase, "[time]", "[solver]\nstress_filter = 0.2\n[time]");
+  const auto o2 = run_case_text(dir, v1);
+  expect_error_at(o2, line_of(v1, "stress_filter"), "solver.stress_filter", {"v2"});
+  const std::string fly =
+      replace(kBase, "[time]", "[solver]\nversion = \"v2\"\nstress_filter = 0.2\noperators = \"on_the_fly\"\n[time]");
+  const auto o3 = run_case_text(dir, fly);
+  expect_error_at(o3, line_of(fly, "operators"), "solver.operators", {"stress filter", "stored"});
+}
+
 TEST(InputErrors, ShiftingNeedsV2WithTheDetectedSurface) {
   test::TempDir dir;
   const std::string text =
