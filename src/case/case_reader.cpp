@@ -349,6 +349,17 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     if (s->has("stress_filter")) {
       s->require(c.version == "v2", "stress_filter", "applies to V2 (solver.version = \"v2\")");
     }
+    const std::string part = s->string("stress_filter_part", "mean");
+    if (part == "mean") {
+      c.stress_filter_part = StressFilterPart::mean;
+    } else if (part == "full") {
+      c.stress_filter_part = StressFilterPart::full;
+    } else {
+      s->fail("stress_filter_part", fmt::format("unknown value '{}' (known: mean, full)", part));
+    }
+    if (s->has("stress_filter_part")) {
+      s->require(c.stress_filter > 0.0, "stress_filter_part", "applies with solver.stress_filter > 0");
+    }
     c.gradient_floor = s->number("gradient_floor", default_gradient_floor<Dim>(c.version));
     s->require(c.gradient_floor >= 0.0 && c.gradient_floor <= 0.5, "gradient_floor",
                fmt::format("must lie in [0, 0.5] (the smallest eigenvalue allowed for a row's gradient "

@@ -168,6 +168,8 @@ enum class SortSetting { off, automatic, always };
 
 /// When V2 shifts its nodes (solver.shift).
 enum class ShiftSetting { off, automatic, periodic };
+/// What V2's nodal stress filter acts on (solver.stress_filter_part, method-notes eq. (2.3.4)).
+enum class StressFilterPart { mean, full };
 
 enum class InitialStressKind { zero, geostatic, uniform };
 /// 1D only: the lateral condition of the bar (docs/cases.md §1.1, Case 2).
@@ -270,6 +272,9 @@ struct CaseSetup {
   /// (I - P_NE P_EN)^2 sigma after step 2 (method-notes eq. (2.3.4); solver.stress_filter).
   /// 0: off. It removes the nodal stress mode at eps a step and leaves linear fields exactly.
   double stress_filter = 0.0;
+  /// What the stress filter acts on (solver.stress_filter_part): the mean stress (default) or
+  /// every component.
+  StressFilterPart stress_filter_part = StressFilterPart::mean;
   /// The corrected operators' gradient floor (method-notes eq. (3.2.6); solver.gradient_floor):
   /// a row whose gradient renormalisation matrix has an eigenvalue below it (a thin sheet of
   /// particles, a lone particle) is regularised. The reader's default: default_gradient_floor.

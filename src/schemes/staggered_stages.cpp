@@ -605,10 +605,11 @@ namespace {
 // f <- f - eps (I - P_NE P_EN)^2 f on the nodal field f of NC values a node (method-notes §0.3
 // item 3, eq. (2.3.4)): P_EN interpolates nodes to stress points, P_NE back. The mode that the
 // stress points cannot see (P_EN f = 0) loses eps of itself; a linear field, which both
-// interpolations reproduce, is left exactly; a smooth one changes at O(eps h^4).
-template <int Dim, int NC>
-void filter_nodal_checkerboard(StaggeredModel<Dim>& m, double* field, double eps, std::vector<double>& at_sp,
-                               std::vector<double>& at_nodes) {
+// interpolations reproduce, is left exactly; a smooth one changes at O(eps h^4). remove(f_i, r)
+// takes eps r = eps [(I - P_NE P_EN)^2 f]_i, or the part of it the caller filters, from f_i.
+template <int Dim, int NC, class Remove>
+void filter_nodal_checkerboard(StaggeredModel<Dim>& m, double* field, std::vector<double>& at_sp,
+                               std::vector<double>& at_nodes, Remove&& remove) {
   const Index ne = m.stress_points.size();
   const Index nn = m.nodes.size();
   // Re-seeded stress points (V2) change their count; otherwise this never allocates.
@@ -660,7 +661,8 @@ void filter_nodal_checkerboard(StaggeredModel<Dim>& m, double* field, double eps
   exec::particle_for(m.policy, nn, [&](Index i) {
     double acc[NC];
     back_to_nodes(i, acc);
-    for (int c = 0; c < NC; ++c) f(i, c) -= eps * (filter_node(i, c) - acc[c]);
+    for (int c = 0; c < NC; ++c) acc[c] = filter_node(i, c) - acc[c];
+    remove(f[i], acc);
   });
 }
 
@@ -675,21 +677,38 @@ VelocityFilter<Dim>::VelocityFilter(StaggeredModel<Dim>& model, double strength)
 
 template <int Dim>
 void VelocityFilter<Dim>::run(const StepContext&) {
-  filter_nodal_checkerboard<Dim, Dim>(m_, m_.nodes.view(m_.fields.velocity).data(), strength_, at_stress_points_,
-                                      at_nodes_);
+  const double eps = strength_;
+  filter_nodal_checkerboard<Dim, Dim>(m_, m_.nodes.view(m_.fields.velocity).data(), at_stress_points_, at_nodes_,
+                                      [eps](double* v, const double(&r)[Dim]) {
+                                        for (int d = 0; d < Dim; ++d) v[d] -= eps * r[d];
+                                      });
 }
 
 template <int Dim>
-StressFilter<Dim>::StressFilter(StaggeredModel<Dim>& model, double strength)
+StressFilter<Dim>::StressFilter(StaggeredModel<Dim>& model, double strength, StressFilterPart part)
     : m_(model),
       strength_(strength),
+      part_(part),
       at_stress_points_(static_cast<std::size_t>(model.stress_points.size()) * NS, 0.0),
       at_nodes_(static_cast<std::size_t>(model.nodes.size()) * NS, 0.0) {}
 
 template <int Dim>
 void StressFilter<Dim>::run(const StepContext&) {
-  filter_nodal_checkerboard<Dim, NS>(m_, m_.nodes.view(m_.fields.stress).data(), strength_, at_stress_points_,
-                                     at_nodes_);
+  const double eps = strength_;
+  double* stress = m_.nodes.view(m_.fields.stress).data();
+  if (part_ == StressFilterPart::full) {
+    filter_nodal_checkerboard<Dim, NS>(m_, stress, at_stress_points_, at_nodes_,
+                                       [eps](double* s, const double(&r)[NS]) {
+                                         for (int k = 0; k < NS; ++k) s[k] -= eps * r[k];
+                                       });
+    return;
+  }
+  // The mean stress only (slots 0-2 are the normal components in every dimension): the
+  // deviator, which a yield surface bounds and which carries the soil's strength, is left.
+  filter_nodal_checkerboard<Dim, NS>(m_, stress, at_stress_points_, at_nodes_, [eps](double* s, const double(&r)[NS]) {
+    const double mean = (r[0] + r[1] + r[2]) / 3.0;
+    for (int k = 0; k < 3; ++k) s[k] -= eps * mean;
+  });
 }
 
 #define RKTSPH_INSTANTIATE(D)                                                 \

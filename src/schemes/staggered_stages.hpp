@@ -151,12 +151,13 @@ class VelocityFilter final : public Stage {
 
 /// sigma <- sigma - eps (I - P_NE P_EN)^2 sigma on the nodal stress (V2, method-notes eq.
 /// (2.3.4)): the same fourth-order filter for the nodal stress mode that the stress points
-/// cannot see; exact on linear fields, objective (it commutes with a uniform rotation).
+/// cannot see, on the mean stress (default) or every component; exact on linear fields,
+/// objective (it commutes with a uniform rotation).
 template <int Dim>
 class StressFilter final : public Stage {
  public:
   static constexpr int NS = kStressComponents<Dim>;
-  StressFilter(StaggeredModel<Dim>& model, double strength);
+  StressFilter(StaggeredModel<Dim>& model, double strength, StressFilterPart part);
   std::string_view name() const override { return "stress_filter"; }
   void run(const StepContext& context) override;
   std::size_t scratch_bytes() const override { return (at_stress_points_.size() + at_nodes_.size()) * sizeof(double); }
@@ -164,6 +165,7 @@ class StressFilter final : public Stage {
  private:
   StaggeredModel<Dim>& m_;
   double strength_;
+  StressFilterPart part_;
   std::vector<double> at_stress_points_, at_nodes_;  // NS values per particle
 };
 

@@ -85,7 +85,7 @@ std::unique_ptr<Scheme> make_v2_scheme(StaggeredModel<Dim>& model) {
   auto add_stress_filter = [&] {
     if (model.setup.operators_on_the_fly)
       throw std::logic_error("v2 scheme: the stress filter needs the stored operators (the reader chooses them)");
-    scheme->add(std::make_unique<StressFilter<Dim>>(model, model.setup.stress_filter));
+    scheme->add(std::make_unique<StressFilter<Dim>>(model, model.setup.stress_filter, model.setup.stress_filter_part));
   };
   if (model.setup.simple_velocity) {
     scheme->add(std::make_unique<NodeFullStep<Dim, MovingParticles, SimpleVelocity>>(model, sources))

@@ -220,7 +220,7 @@ TEST(InputErrors, SimpleStressWeightOutOfRangeOrOutsideV2) {
   expect_error_at(o2, line_of(v1, "simple_stress_weight"), "solver.simple_stress_weight", {"v2"});
 }
 
-TEST(InputErrors, StressFilterOutOfRangeOutsideV2OrOnTheFly) {
+TEST(InputErrors, StressFilterOutOfRangeOutsideV2OnTheFlyOrUnknownPart) {
   test::TempDir dir;
   const std::string text = replace(kBase, "[time]", "[solver]\nversion = \"v2\"\nstress_filter = -0.1\n[time]");
   const auto o = run_case_text(dir, text);
@@ -232,6 +232,10 @@ TEST(InputErrors, StressFilterOutOfRangeOutsideV2OrOnTheFly) {
       replace(kBase, "[time]", "[solver]\nversion = \"v2\"\nstress_filter = 0.2\noperators = \"on_the_fly\"\n[time]");
   const auto o3 = run_case_text(dir, fly);
   expect_error_at(o3, line_of(fly, "operators"), "solver.operators", {"stress filter", "stored"});
+  const std::string part = replace(
+      kBase, "[time]", "[solver]\nversion = \"v2\"\nstress_filter = 0.2\nstress_filter_part = \"deviator\"\n[time]");
+  const auto o4 = run_case_text(dir, part);
+  expect_error_at(o4, line_of(part, "stress_filter_part"), "solver.stress_filter_part", {"mean", "full"});
 }
 
 TEST(InputErrors, ShiftingNeedsV2WithTheDetectedSurface) {
