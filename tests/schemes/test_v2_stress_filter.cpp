@@ -9,7 +9,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <numbers>
 
 #include "../support/test_util.hpp"
 #include "../support/v2_block.hpp"
@@ -39,16 +38,8 @@ std::vector<double> interior_checkerboard(double eps, StressFilterPart part, con
   const std::vector<Vec<2>> start = sim.nodes().position;
   std::vector<double> amplitude;
   auto measure = [&] {
-    const auto now = sim.node_stress();
-    const std::vector<Index> at = sim.nodes_by_id();
-    double sum = 0.0;
-    long count = 0;
-    for (std::size_t k = 0; k < start.size(); ++k) {
-      if (std::abs(start[k][0]) > 0.5 + 1e-9 || std::abs(start[k][1]) > 0.5 + 1e-9) continue;
-      sum += sign[k] * now(at[k], static_cast<StressComponent>(read));
-      ++count;
-    }
-    amplitude.push_back(std::abs(sum) / static_cast<double>(count) / 1.0e3);
+    amplitude.push_back(
+        test::interior_checkerboard_amplitude(sim, sign, start, static_cast<StressComponent>(read), 1.0e3));
   };
   measure();
   for (int n = 0; n < steps; ++n) {
@@ -149,29 +140,11 @@ TEST(V2StressFilter, LeavesAQuadraticStressFieldUntouched) {
 // filter leaves, rotates by the angle turned, to round-off, over a quarter turn.
 TEST(V2StressFilter, AUniformStressStillRotatesObjectively) {
   const test::ThreadCount threads(1);
-  const double omega = std::numbers::pi / 2.0;
   const int steps = 8;
-  CaseBuilder<2> b("v2 block, rigid rotation with the stress filter");
-  b.spacing(0.1)
-      .origin(Vec<2>(-5.0, -5.0))
-      .block(Vec<2>(-5.0, -5.0), Vec<2>(5.0, 5.0))
-      .elastic(1.0e7, 0.3, 1.0e20)
-      .scheme("v2")
-      .initial_stress({-1.0e4, -3.0e4, -2.0e4, 5.0e3, 0.0, 0.0})
-      .time_step(1.0, 1.0 / steps);
-  Simulation<2> sim(filtered(b.build(), 0.5, StressFilterPart::full));
-  const std::vector<Vec<2>> start = sim.nodes().position;
-  for (int n = 0; n < steps; ++n) {
-    auto v = sim.mutable_node_velocity();
-    for (std::size_t i = 0; i < sim.nodes().position.size(); ++i) {
-      const auto& x = sim.nodes().position[i];
-      v(i, 0) = -omega * x[1];
-      v(i, 1) = omega * x[0];
-    }
-    sim.step();
-  }
-  ASSERT_NEAR(omega * sim.time(), std::numbers::pi / 2.0, 1e-12);
-  const test::RotationCheck r = test::rotated_stress_error(sim, start, omega * sim.time(), 0.5);
+  Simulation<2> sim(filtered(test::rotation_block("v2 block, rigid rotation with the stress filter", steps).build(),
+                             0.5, StressFilterPart::full));
+  const test::RotationCheck r = test::spin_rigidly(sim, steps);
+  ASSERT_NEAR(sim.time(), 1.0, 1e-12);  // a quarter turn
   ASSERT_GT(r.nodes, 80);
   EXPECT_LT(r.worst / 3.0e4, 1e-11) << "max stress error " << r.worst << " Pa";
 }

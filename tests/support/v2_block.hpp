@@ -1,9 +1,11 @@
 // The V2 tests' 2 m x 2 m elastic block (E = 10 MPa, nu = 0.3, rho = 2000 kg/m^3) centred at the
-// origin on a 0.1 m lattice, free faces, to 1 s at C = 0.5.
+// origin on a 0.1 m lattice, free faces, to 1 s at C = 0.5; and the rotation and checkerboard
+// checks that the V2 stress tests share.
 #pragma once
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -61,6 +63,57 @@ inline RotationCheck rotated_stress_error(const Simulation<2>& sim, const std::v
                   std::abs(stress(i, StressComponent::xy) - xy), std::abs(stress(i, StressComponent::zz) - zz)});
   }
   return r;
+}
+
+/// The V2 Jaumann tests' block: 10 m, 0.1 m lattice, elastic with a density that makes it
+/// stiff against its own inertia, the uniform stress of rotated_stress_error, a quarter turn of
+/// rigid rotation in `steps` fixed steps (`spin_rigidly`).
+inline CaseBuilder<2> rotation_block(const std::string& name, int steps) {
+  CaseBuilder<2> b(name);
+  b.spacing(0.1)
+      .origin(Vec<2>(-5.0, -5.0))
+      .block(Vec<2>(-5.0, -5.0), Vec<2>(5.0, 5.0))
+      .elastic(1.0e7, 0.3, 1.0e20)
+      .scheme("v2")
+      .initial_stress({-1.0e4, -3.0e4, -2.0e4, 5.0e3, 0.0, 0.0})
+      .time_step(1.0, 1.0 / steps);
+  return b;
+}
+
+/// Rigid rotation at pi/2 rad/s about the origin, the velocity reset to omega x x before every
+/// one of `steps` steps; then the rigid-rotation check of the nodes that started within 0.5 m of
+/// the centre, which the faces' traction-free stress cannot reach in 8 steps (each step's
+/// interpolations spread it by at most 4.8 dx).
+inline RotationCheck spin_rigidly(Simulation<2>& sim, int steps) {
+  const double omega = std::numbers::pi / 2.0;
+  const std::vector<Vec<2>> start = sim.nodes().position;
+  for (int n = 0; n < steps; ++n) {
+    auto v = sim.mutable_node_velocity();
+    for (std::size_t i = 0; i < sim.nodes().position.size(); ++i) {
+      const auto& x = sim.nodes().position[i];
+      v(i, 0) = -omega * x[1];
+      v(i, 1) = omega * x[0];
+    }
+    sim.step();
+  }
+  return rotated_stress_error(sim, start, omega * sim.time(), 0.5);
+}
+
+/// The amplitude of a nodal checkerboard of sign `sign` (lattice_checkerboard of the start
+/// positions `start`) on stress component `read`, over the nodes that started 0.5 m or more
+/// inside the test block's faces, relative to `scale`.
+inline double interior_checkerboard_amplitude(const Simulation<2>& sim, const std::vector<double>& sign,
+                                              const std::vector<Vec<2>>& start, StressComponent read, double scale) {
+  const auto now = sim.node_stress();
+  const std::vector<Index> at = sim.nodes_by_id();
+  double sum = 0.0;
+  long count = 0;
+  for (std::size_t k = 0; k < start.size(); ++k) {
+    if (std::abs(start[k][0]) > 0.5 + 1e-9 || std::abs(start[k][1]) > 0.5 + 1e-9) continue;
+    sum += sign[k] * now(at[k], read);
+    ++count;
+  }
+  return std::abs(sum) / static_cast<double>(count) / scale;
 }
 
 }  // namespace rktsph::test
