@@ -262,11 +262,12 @@ CaseReport validate_case09(const Options& opt, const std::string& dir) {
       "but the column does not flow out: it slumps as a block, the node columns parting along vertical lines (the "
       "detected surface follows those gaps), and stops high and short (front {:.1f} m against x_f = {:.1f} m). The "
       "simple scheme's averaging of the nodal velocity (method-notes §2.3) acts as a viscosity of order rho c_p dx "
-      "that a column whose cohesion is 1/50 of gamma H cannot overcome (a lower solver.simple_weight, eq. (2.3.2), "
-      "lengthens the run-out with the viscosity, but at 0.125 m w = 0.25 stops at 4.15 s even with every component of "
-      "the nodal stress filtered, eq. (2.3.4) at 0.5; the case filters the nodal mean stress, solver.stress_filter = "
-      "0.5, which removed the nodal stress mode that threw a node out of the full run at 14.47 s). With the filter the "
-      "deposit still creeps at 20 s (kinetic energy 4-7e-4 of its peak)",
+      "that a column whose cohesion is 1/50 of gamma H cannot overcome (the case halves it, solver.simple_weight = "
+      "0.5, "
+      "eq. (2.3.2), which lengthens the run-out; lower weights stop at 0.125 m, w = 0.25 at 4.15 s even with every "
+      "component of the nodal stress filtered; the case filters the nodal mean stress, solver.stress_filter = 0.5, "
+      "eq. (2.3.4), which removed the nodal stress mode that threw a node out of the full run at 14.47 s). The "
+      "deposit still creeps at 20 s (kinetic energy 2-3e-4 of its peak)",
       front, xf);
   auto push = [&](Metric m) {
     if (!m.pass()) m.known_deviation = r.stopped.empty() ? stiff : unstable;
