@@ -452,18 +452,9 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
                  "sorting the particles needs solver.version = \"v2\" (fixed particles keep the lattice's order, "
                  "which their operators' shared rows rely on)");
     }
-    // After velocity_update and filter, which decide "auto".
-    const bool filtered = !c.simple_velocity && c.filter;
+    // "auto" is on the fly: the nodal filters apply the weights the steps keep as they go.
     const std::string operators = s->string("operators", "auto");
-    if (operators == "auto") {
-      c.operators_on_the_fly = !filtered && c.stress_filter == 0.0;
-    } else if (operators == "on_the_fly") {
-      s->require(!filtered, "operators",
-                 "\"on_the_fly\" cannot serve V1's velocity filter, which applies the stored operators "
-                 "(velocity_update = \"taylor_galerkin\" with filter = true): use \"stored\" or \"auto\"");
-      s->require(c.stress_filter == 0.0, "operators",
-                 "\"on_the_fly\" cannot serve the stress filter (solver.stress_filter > 0), which applies the "
-                 "stored operators: use \"stored\" or \"auto\"");
+    if (operators == "auto" || operators == "on_the_fly") {
       c.operators_on_the_fly = true;
     } else if (operators == "stored") {
       c.operators_on_the_fly = false;

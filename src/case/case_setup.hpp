@@ -314,8 +314,8 @@ struct CaseSetup {
   /// V2: the corrected operators applied on the fly in the steps, from the current positions,
   /// without storing a weight per pair (method-notes §5.2, "Operators on the fly"), or stored
   /// as weights rebuilt at the start of every step (solver.operators = "on_the_fly" |
-  /// "stored"; "auto" is on the fly unless V1's velocity filter, which applies the stored
-  /// operators, is on).
+  /// "stored"; "auto" is on the fly: a nodal filter then applies the interpolation weights
+  /// that steps 1 and 2 keep, MovingOperators::record_interpolation).
   bool operators_on_the_fly = true;
   /// V2: the domain box [min, max] (solver.domain_min / domain_max): particles that leave it
   /// are deactivated (schemes/deactivate_stage.hpp); empty: no box. `domain_where` names the

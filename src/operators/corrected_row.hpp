@@ -134,6 +134,24 @@ class CorrectedRow {
     }
   }
 
+  /// The value's pair weights alone, interp[k] as weights() writes it (Shepard's when
+  /// degenerate): what a nodal filter needs to apply the row again after the step (method-notes
+  /// eq. (2.3.4), with the operators on the fly).
+  void value_weights(double* interp) const {
+    const double* w[N];
+    for (int i = 0; i < N; ++i) w[i] = basis_[i].data();
+    if (ok_) {
+#pragma omp simd
+      for (std::size_t k = 0; k < n_; ++k) {
+        double c = 0.0;
+        for (int j = 0; j < N; ++j) c += minv_[0][j] * w[j][k];
+        interp[k] = c;
+      }
+    } else {
+      for (std::size_t k = 0; k < n_; ++k) interp[k] = shepard_ > 0.0 ? w[0][k] / shepard_ : 0.0;
+    }
+  }
+
   /// The corrected value (out[0]) and gradient (out[1 + d], d/dx_d) at the target of two fields
   /// of NA and NB values per source (`field_a` + NA b holds source b's), eq. (3.2.3) applied as
   /// M_a^{-1} sum_b w_b f_b, in one pass over the pairs (the state of V2's steps: velocity and

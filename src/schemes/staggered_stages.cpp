@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <utility>
 
@@ -87,6 +88,14 @@ RowCounts rows_on_the_fly(const exec::Threads& policy, const OnTheFlySources<Dim
       },
       exec::Schedule::even, rows);
   return {degenerate.load(), regularised.load(), pairs.load()};
+}
+
+// Row a's interpolation weights and sources kept for the nodal filters (MovingOperators).
+template <int Dim>
+inline void record_row(RecordedInterpolation<Dim>& record, const CorrectedRow<Dim>& row, Index a) {
+  const std::size_t k0 = record.declare(a, row.size());
+  std::copy(row.sources(), row.sources() + row.size(), record.source.begin() + static_cast<std::ptrdiff_t>(k0));
+  row.value_weights(record.weight.data() + k0);
 }
 
 // V2 (method-notes §1.3, §5.2): particle i of `set` after its rotation over dt: the density by
@@ -257,6 +266,8 @@ void StressPointHalfStep<Dim, PressureTerm, Motion>::run(const StepContext& c) {
       const ParticleSet<Dim>& nodes = m_.nodes;
       const OnTheFlySources<Dim> from{candidates,          sp.position,   nodes.position.data(),
                                       nodes.volume.data(), node_v.data(), node_s.data()};
+      const bool record = mo.record_interpolation;
+      if (record) mo.nodes_to_stress_points.prepare(candidates);
       const RowCounts counts = rows_on_the_fly<Dim>(
           m_.policy, from, m_.kernel, mo.r2, m_.setup.gradient_floor,
           [&](const CorrectedRow<Dim>& row, Index e, const double(&bar_v)[Dim], const double(&grad_v)[Dim][Dim],
@@ -264,6 +275,7 @@ void StressPointHalfStep<Dim, PressureTerm, Motion>::run(const StepContext& c) {
             const auto eu = static_cast<std::size_t>(e);
             mo.stress_point_position[eu] = sp.position[eu];
             mo.stress_point_volume[eu] = sp.volume[eu];
+            if (record) record_row(mo.nodes_to_stress_points, row, e);
             update(e, bar_v, grad_v, bar_s, grad_s, nullptr,
                    [&](double* ks) { row.interpolate(node_k.data(), stride, ks); });
           });
@@ -533,15 +545,18 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
     if (moving_ != nullptr && moving_->on_the_fly) {
       // V2, operators on the fly (method-notes §5.2): each node's row evaluated from its
       // candidates at the stress points' positions and volumes of t^n, kept by step 1.
-      const MovingOperators<Dim>& mo = *moving_;
+      MovingOperators<Dim>& mo = *moving_;
       const Relation<Dim>& candidates = *mo.stress_points_near_nodes;
       const OnTheFlySources<Dim> from{
           candidates,  nodes.position, mo.stress_point_position.data(), mo.stress_point_volume.data(),
           sp_v.data(), sp_s.data()};
+      const bool record = mo.record_interpolation;
+      if (record) mo.stress_points_to_nodes.prepare(candidates);
       const RowCounts counts =
           rows_on_the_fly<Dim>(m_.policy, from, m_.kernel, mo.r2, m_.setup.gradient_floor,
                                [&](const CorrectedRow<Dim>& row, Index i, double(&v_half)[Dim],
                                    double(&grad_v)[Dim][Dim], double(&s_half)[NS], double(&grad_s)[Dim][NS]) {
+                                 if (record) record_row(mo.stress_points_to_nodes, row, i);
                                  update(i, grad_v, grad_s, v_half, row.regularised() || row.degenerate(), s_half);
                                });
       m_.to_nodes.degenerate_rows = counts.degenerate;
@@ -602,28 +617,18 @@ void NodeFullStep<Dim, Motion, Velocity>::load(const io::StateArchive& a, const 
 
 namespace {
 
-// f <- f - eps (I - P_NE P_EN)^2 f on the nodal field f of NC values a node (method-notes §0.3
-// item 3, eq. (2.3.4)): P_EN interpolates nodes to stress points, P_NE back. The mode that the
-// stress points cannot see (P_EN f = 0) loses eps of itself; a linear field, which both
-// interpolations reproduce, is left exactly; a smooth one changes at O(eps h^4). remove(f_i, r)
-// takes eps r = eps [(I - P_NE P_EN)^2 f]_i, or the part of it the caller filters, from f_i.
-template <int Dim, int NC, class Remove>
-void filter_nodal_checkerboard(StaggeredModel<Dim>& m, double* field, std::vector<double>& at_sp,
-                               std::vector<double>& at_nodes, Remove&& remove) {
-  const Index ne = m.stress_points.size();
-  const Index nn = m.nodes.size();
-  // Re-seeded stress points (V2) change their count; otherwise this never allocates.
-  if (at_sp.size() != static_cast<std::size_t>(ne) * NC) at_sp.assign(static_cast<std::size_t>(ne) * NC, 0.0);
-  if (at_nodes.size() != static_cast<std::size_t>(nn) * NC) at_nodes.assign(static_cast<std::size_t>(nn) * NC, 0.0);
-  const CorrectedOperator<Dim>& en = m.to_stress_points;
-  const CorrectedOperator<Dim>& ne_op = m.to_nodes;
-  FieldView<double, NC> filter_sp(at_sp.data(), ne, NC);
-  FieldView<double, NC> filter_node(at_nodes.data(), nn, NC);
-  FieldView<double, NC> f(field, nn, NC);
-  auto to_stress_points = [&](const double* node_field) {
+// The two interpolations the nodal filters apply, P_EN (nodes to stress points) and P_NE (back),
+// from the model's stored operators (V1, V3, and V2 with solver.operators = "stored")...
+template <int Dim>
+struct StoredInterpolations {
+  const CorrectedOperator<Dim>& en;
+  const CorrectedOperator<Dim>& ne;
+
+  template <int NC>
+  void to_stress_points(const exec::Threads& policy, Index targets, const double* node_field, double* out) const {
     // By runs (run_sums): the vector loop over a run's contiguous sources.
     exec::particle_for(
-        m.policy, en.runs(),
+        policy, en.runs(),
         [&](Index r) {
           double acc[CorrectedOperator<Dim>::kMaxRun * NC];
           double* sums[1] = {acc};
@@ -635,35 +640,93 @@ void filter_nodal_checkerboard(StaggeredModel<Dim>& m, double* field, std::vecto
               node_field + static_cast<std::size_t>(en.base[e0u]) * NC, NC, static_cast<std::size_t>(e1 - e0) * NC,
               en.offset.data(), en.pattern_start[p], en.pattern_start[p + 1],
               [&](Index k, double* w) { w[0] = en.interp[static_cast<std::size_t>(k)]; }, sums);
-          for (Index e = e0; e < e1; ++e) {
-            for (int c = 0; c < NC; ++c)
-              filter_sp(e, c) = acc[static_cast<std::size_t>(e - e0) * NC + static_cast<std::size_t>(c)];
-          }
+          std::copy(acc, acc + static_cast<std::size_t>(e1 - e0) * NC, out + e0u * NC);
         },
-        exec::Schedule::even, ne);
-  };
-  auto back_to_nodes = [&](Index i, double* acc) {
+        exec::Schedule::even, targets);
+  }
+  template <int NC>
+  void at_node(Index i, const double* sp_field, double* acc) const {
     for (int c = 0; c < NC; ++c) acc[c] = 0.0;
-    const auto row = ne_op.row(i);
+    const auto row = ne.row(i);
     for (Index k = row.begin; k < row.end; ++k) {
-      const double wk = ne_op.interp[static_cast<std::size_t>(k)];
-      const double* p = filter_sp[ne_op.source(row, k)];
+      const double wk = ne.interp[static_cast<std::size_t>(k)];
+      const double* p = sp_field + static_cast<std::size_t>(ne.source(row, k)) * NC;
       for (int c = 0; c < NC; ++c) acc[c] += wk * p[c];
     }
-  };
-  to_stress_points(field);
+  }
+};
+
+// ... or from the weights V2's steps kept while they evaluated their rows on the fly
+// (MovingOperators::record_interpolation): the same operators of t^n.
+template <int Dim>
+struct RecordedInterpolations {
+  const RecordedInterpolation<Dim>& en;
+  const RecordedInterpolation<Dim>& ne;
+
+  template <int NC>
+  static void row_sum(const RecordedInterpolation<Dim>& op, Index a, const double* field, double* acc) {
+    for (int c = 0; c < NC; ++c) acc[c] = 0.0;
+    for (std::size_t k = op.begin(a), k1 = op.end(a); k < k1; ++k) {
+      const double wk = op.weight[k];
+      const double* p = field + static_cast<std::size_t>(op.source[k]) * NC;
+      for (int c = 0; c < NC; ++c) acc[c] += wk * p[c];
+    }
+  }
+  template <int NC>
+  void to_stress_points(const exec::Threads& policy, Index, const double* node_field, double* out) const {
+    exec::particle_for(policy, en.rows(),
+                       [&](Index e) { row_sum<NC>(en, e, node_field, out + static_cast<std::size_t>(e) * NC); });
+  }
+  template <int NC>
+  void at_node(Index i, const double* sp_field, double* acc) const {
+    row_sum<NC>(ne, i, sp_field, acc);
+  }
+};
+
+// f <- f - eps (I - P_NE P_EN)^2 f on the nodal field f of NC values a node (method-notes §0.3
+// item 3, eq. (2.3.4)): P_EN interpolates nodes to stress points, P_NE back. The mode that the
+// stress points cannot see (P_EN f = 0) loses eps of itself; a linear field, which both
+// interpolations reproduce, is left exactly; a smooth one changes at O(eps h^4). remove(i, f_i, r)
+// takes eps r = eps [(I - P_NE P_EN)^2 f]_i, or the part of it the caller filters, from f_i (or
+// from the field f was derived from).
+template <int Dim, int NC, class Interpolations, class Remove>
+void filter_nodal_checkerboard_with(const StaggeredModel<Dim>& m, const Interpolations& op, double* field,
+                                    std::vector<double>& at_sp, std::vector<double>& at_nodes, Remove&& remove) {
+  const Index ne = m.stress_points.size();
+  const Index nn = m.nodes.size();
+  // Re-seeded stress points (V2) change their count; otherwise this never allocates.
+  if (at_sp.size() != static_cast<std::size_t>(ne) * NC) at_sp.assign(static_cast<std::size_t>(ne) * NC, 0.0);
+  if (at_nodes.size() != static_cast<std::size_t>(nn) * NC) at_nodes.assign(static_cast<std::size_t>(nn) * NC, 0.0);
+  FieldView<double, NC> filter_node(at_nodes.data(), nn, NC);
+  FieldView<double, NC> f(field, nn, NC);
+  op.template to_stress_points<NC>(m.policy, ne, field, at_sp.data());
   exec::particle_for(m.policy, nn, [&](Index i) {
     double acc[NC];
-    back_to_nodes(i, acc);
+    op.template at_node<NC>(i, at_sp.data(), acc);
     for (int c = 0; c < NC; ++c) filter_node(i, c) = f(i, c) - acc[c];
   });
-  to_stress_points(filter_node.data());
+  op.template to_stress_points<NC>(m.policy, ne, filter_node.data(), at_sp.data());
   exec::particle_for(m.policy, nn, [&](Index i) {
     double acc[NC];
-    back_to_nodes(i, acc);
+    op.template at_node<NC>(i, at_sp.data(), acc);
     for (int c = 0; c < NC; ++c) acc[c] = filter_node(i, c) - acc[c];
-    remove(f[i], acc);
+    remove(i, f[i], acc);
   });
+}
+
+// The filter with the interpolations of the step: recorded on the fly (V2's default) or stored.
+template <int Dim, int NC, class Remove>
+void filter_nodal_checkerboard(const StaggeredModel<Dim>& m, const MovingOperators<Dim>* moving, double* field,
+                               std::vector<double>& at_sp, std::vector<double>& at_nodes, Remove&& remove) {
+  if (moving != nullptr && moving->on_the_fly) {
+    if (!moving->record_interpolation)
+      throw std::logic_error("nodal filter on the fly: the steps were not asked to record their interpolations");
+    const RecordedInterpolations<Dim> op{moving->nodes_to_stress_points, moving->stress_points_to_nodes};
+    filter_nodal_checkerboard_with<Dim, NC>(m, op, field, at_sp, at_nodes, std::forward<Remove>(remove));
+  } else {
+    const StoredInterpolations<Dim> op{m.to_stress_points, m.to_nodes};
+    filter_nodal_checkerboard_with<Dim, NC>(m, op, field, at_sp, at_nodes, std::forward<Remove>(remove));
+  }
 }
 
 }  // namespace
@@ -678,37 +741,60 @@ VelocityFilter<Dim>::VelocityFilter(StaggeredModel<Dim>& model, double strength)
 template <int Dim>
 void VelocityFilter<Dim>::run(const StepContext&) {
   const double eps = strength_;
-  filter_nodal_checkerboard<Dim, Dim>(m_, m_.nodes.view(m_.fields.velocity).data(), at_stress_points_, at_nodes_,
-                                      [eps](double* v, const double(&r)[Dim]) {
+  filter_nodal_checkerboard<Dim, Dim>(m_, moving_, m_.nodes.view(m_.fields.velocity).data(), at_stress_points_,
+                                      at_nodes_, [eps](Index, double* v, const double(&r)[Dim]) {
                                         for (int d = 0; d < Dim; ++d) v[d] -= eps * r[d];
                                       });
 }
 
 template <int Dim>
 StressFilter<Dim>::StressFilter(StaggeredModel<Dim>& model, double strength, StressFilterPart part)
-    : m_(model),
-      strength_(strength),
-      part_(part),
-      at_stress_points_(static_cast<std::size_t>(model.stress_points.size()) * NS, 0.0),
-      at_nodes_(static_cast<std::size_t>(model.nodes.size()) * NS, 0.0) {}
+    : m_(model), strength_(strength), part_(part) {
+  resize_scratch();
+}
+
+template <int Dim>
+void StressFilter<Dim>::resize_scratch() {
+  // The full tensor: NS values a particle; the mean stress: one.
+  const std::size_t nc = part_ == StressFilterPart::full ? NS : 1;
+  at_stress_points_.assign(static_cast<std::size_t>(m_.stress_points.size()) * nc, 0.0);
+  at_nodes_.assign(static_cast<std::size_t>(m_.nodes.size()) * nc, 0.0);
+  if (part_ == StressFilterPart::mean) mean_.assign(static_cast<std::size_t>(m_.nodes.size()), 0.0);
+}
 
 template <int Dim>
 void StressFilter<Dim>::run(const StepContext&) {
+  const auto t0 = std::chrono::steady_clock::now();
+  filter();
+  seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+template <int Dim>
+void StressFilter<Dim>::filter() {
   const double eps = strength_;
-  double* stress = m_.nodes.view(m_.fields.stress).data();
+  FieldView<double, NS> stress = m_.nodes.view(m_.fields.stress);
   if (part_ == StressFilterPart::full) {
-    filter_nodal_checkerboard<Dim, NS>(m_, stress, at_stress_points_, at_nodes_,
-                                       [eps](double* s, const double(&r)[NS]) {
+    filter_nodal_checkerboard<Dim, NS>(m_, moving_, stress.data(), at_stress_points_, at_nodes_,
+                                       [eps](Index, double* s, const double(&r)[NS]) {
                                          for (int k = 0; k < NS; ++k) s[k] -= eps * r[k];
                                        });
     return;
   }
   // The mean stress only (slots 0-2 are the normal components in every dimension): the
   // deviator, which a yield surface bounds and which carries the soil's strength, is left.
-  filter_nodal_checkerboard<Dim, NS>(m_, stress, at_stress_points_, at_nodes_, [eps](double* s, const double(&r)[NS]) {
-    const double mean = (r[0] + r[1] + r[2]) / 3.0;
-    for (int k = 0; k < 3; ++k) s[k] -= eps * mean;
+  // Both interpolations are linear, so the filter of the mean is the mean of the components'
+  // filters (to round-off); filtered as one scalar a node, it costs a quarter of the tensor's.
+  const Index nn = m_.nodes.size();
+  if (mean_.size() != static_cast<std::size_t>(nn)) mean_.assign(static_cast<std::size_t>(nn), 0.0);
+  exec::particle_for(m_.policy, nn, [&](Index i) {
+    const double* s = stress[i];
+    mean_[static_cast<std::size_t>(i)] = (s[0] + s[1] + s[2]) / 3.0;
   });
+  filter_nodal_checkerboard<Dim, 1>(m_, moving_, mean_.data(), at_stress_points_, at_nodes_,
+                                    [eps, &stress](Index i, double*, const double(&r)[1]) {
+                                      double* s = stress[i];
+                                      for (int k = 0; k < 3; ++k) s[k] -= eps * r[0];
+                                    });
 }
 
 #define RKTSPH_INSTANTIATE(D)                                                 \

@@ -142,9 +142,16 @@ class VelocityFilter final : public Stage {
   std::string_view name() const override { return "velocity_filter"; }
   void run(const StepContext& context) override;
   std::size_t scratch_bytes() const override { return (at_stress_points_.size() + at_nodes_.size()) * sizeof(double); }
+  /// Moving particles (V2): the interpolations of the step, on the fly or stored; on the fly
+  /// it asks steps 1 and 2 to keep their rows' weights (MovingOperators::record_interpolation).
+  void set_moving_operators(MovingOperators<Dim>* moving) {
+    moving_ = moving;
+    if (moving_ != nullptr && moving_->on_the_fly) moving_->record_interpolation = true;
+  }
 
  private:
   StaggeredModel<Dim>& m_;
+  MovingOperators<Dim>* moving_ = nullptr;
   double strength_;
   std::vector<double> at_stress_points_, at_nodes_;  // Dim values per particle
 };
@@ -160,13 +167,30 @@ class StressFilter final : public Stage {
   StressFilter(StaggeredModel<Dim>& model, double strength, StressFilterPart part);
   std::string_view name() const override { return "stress_filter"; }
   void run(const StepContext& context) override;
-  std::size_t scratch_bytes() const override { return (at_stress_points_.size() + at_nodes_.size()) * sizeof(double); }
+  std::size_t scratch_bytes() const override {
+    return (at_stress_points_.size() + at_nodes_.size() + mean_.size()) * sizeof(double);
+  }
+  /// Its time for the log, summary.json and the benchmark.
+  std::vector<std::pair<std::string, double>> report() const override { return {{"stress_filter_seconds", seconds_}}; }
+  double seconds() const { return seconds_; }
+  /// Moving particles (V2): the interpolations of the step, on the fly or stored; on the fly
+  /// it asks steps 1 and 2 to keep their rows' weights (MovingOperators::record_interpolation).
+  void set_moving_operators(MovingOperators<Dim>* moving) {
+    moving_ = moving;
+    if (moving_ != nullptr && moving_->on_the_fly) moving_->record_interpolation = true;
+  }
 
  private:
+  void resize_scratch();
+  void filter();
+
   StaggeredModel<Dim>& m_;
+  MovingOperators<Dim>* moving_ = nullptr;
   double strength_;
   StressFilterPart part_;
-  std::vector<double> at_stress_points_, at_nodes_;  // NS values per particle
+  std::vector<double> at_stress_points_, at_nodes_;  // NS values a particle (full), one (mean)
+  std::vector<double> mean_;                         // the nodal mean stress (mean), Pa
+  double seconds_ = 0.0;
 };
 
 }  // namespace rktsph

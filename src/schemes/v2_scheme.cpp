@@ -16,7 +16,6 @@
 #include <chrono>
 #include <functional>
 #include <memory>
-#include <stdexcept>
 #include <utility>
 
 #include "schemes/deactivate_stage.hpp"
@@ -82,10 +81,10 @@ std::unique_ptr<Scheme> make_v2_scheme(StaggeredModel<Dim>& model) {
       .set_moving_operators(moving);
   // The nodal stress filter (eq. (2.3.4)) on step 2's stress, source included, before the
   // prescribed components and the traction-free rotation put theirs back.
+  // On the fly, steps 1 and 2 keep their rows' interpolation weights for it.
   auto add_stress_filter = [&] {
-    if (model.setup.operators_on_the_fly)
-      throw std::logic_error("v2 scheme: the stress filter needs the stored operators (the reader chooses them)");
-    scheme->add(std::make_unique<StressFilter<Dim>>(model, model.setup.stress_filter, model.setup.stress_filter_part));
+    scheme->add(std::make_unique<StressFilter<Dim>>(model, model.setup.stress_filter, model.setup.stress_filter_part))
+        .set_moving_operators(moving);
   };
   if (model.setup.simple_velocity) {
     scheme->add(std::make_unique<NodeFullStep<Dim, MovingParticles, SimpleVelocity>>(model, sources))
@@ -98,7 +97,8 @@ std::unique_ptr<Scheme> make_v2_scheme(StaggeredModel<Dim>& model) {
     if (model.setup.stress_filter > 0.0) add_stress_filter();
     scheme->add(std::make_unique<ApplyConstraints<Dim>>(model));
     if (model.setup.filter) {
-      scheme->add(std::make_unique<VelocityFilter<Dim>>(model, model.setup.filter_strength));
+      scheme->add(std::make_unique<VelocityFilter<Dim>>(model, model.setup.filter_strength))
+          .set_moving_operators(moving);
       scheme->add(std::make_unique<ApplyConstraints<Dim>>(model));
     }
   }

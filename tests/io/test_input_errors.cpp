@@ -220,7 +220,7 @@ TEST(InputErrors, SimpleStressWeightOutOfRangeOrOutsideV2) {
   expect_error_at(o2, line_of(v1, "simple_stress_weight"), "solver.simple_stress_weight", {"v2"});
 }
 
-TEST(InputErrors, StressFilterOutOfRangeOutsideV2OnTheFlyOrUnknownPart) {
+TEST(InputErrors, StressFilterOutOfRangeOutsideV2OrUnknownPart) {
   test::TempDir dir;
   const std::string text = replace(kBase, "[time]", "[solver]\nversion = \"v2\"\nstress_filter = -0.1\n[time]");
   const auto o = run_case_text(dir, text);
@@ -228,10 +228,6 @@ TEST(InputErrors, StressFilterOutOfRangeOutsideV2OnTheFlyOrUnknownPart) {
   const std::string v1 = replace(kBase, "[time]", "[solver]\nstress_filter = 0.2\n[time]");
   const auto o2 = run_case_text(dir, v1);
   expect_error_at(o2, line_of(v1, "stress_filter"), "solver.stress_filter", {"v2"});
-  const std::string fly =
-      replace(kBase, "[time]", "[solver]\nversion = \"v2\"\nstress_filter = 0.2\noperators = \"on_the_fly\"\n[time]");
-  const auto o3 = run_case_text(dir, fly);
-  expect_error_at(o3, line_of(fly, "operators"), "solver.operators", {"stress filter", "stored"});
   const std::string part = replace(
       kBase, "[time]", "[solver]\nversion = \"v2\"\nstress_filter = 0.2\nstress_filter_part = \"deviator\"\n[time]");
   const auto o4 = run_case_text(dir, part);
@@ -262,19 +258,13 @@ TEST(InputErrors, ParticleSortUnknownOrOutsideV2) {
   expect_error_at(run_case_text(dir, v1), line_of(v1, "sort"), "solver.sort", {"v2"});
 }
 
-TEST(InputErrors, OperatorStorageUnknownOutsideV2OrAgainstTheFilter) {
+TEST(InputErrors, OperatorStorageUnknownOrOutsideV2) {
   test::TempDir dir;
   const std::string unknown = replace(kBase, "[time]", "[solver]\nversion = \"v2\"\noperators = \"cached\"\n[time]");
   expect_error_at(run_case_text(dir, unknown), line_of(unknown, "operators"), "solver.operators",
                   {"auto", "on_the_fly", "stored"});
   const std::string v1 = replace(kBase, "[time]", "[solver]\noperators = \"stored\"\n[time]");
   expect_error_at(run_case_text(dir, v1), line_of(v1, "operators"), "solver.operators", {"v2"});
-  // V1's velocity filter applies the stored operators.
-  const std::string filtered =
-      replace(kBase, "[time]",
-              "[solver]\nversion = \"v2\"\nvelocity_update = \"taylor_galerkin\"\noperators = \"on_the_fly\"\n[time]");
-  expect_error_at(run_case_text(dir, filtered), line_of(filtered, "operators"), "solver.operators",
-                  {"filter", "stored"});
 }
 
 TEST(InputErrors, SurfaceRefreshOutOfRangeOrWithoutDetection) {

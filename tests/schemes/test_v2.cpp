@@ -149,13 +149,20 @@ TEST(V2, SinCosSeriesAgreesWithLibm) {
 // both ways to round-off, the history variables (interpolated with the value row alone) too.
 // With the simple scheme's weight below 1 (eq. (2.3.2)) as well: the stored rows' kinds (corrected,
 // regularised, degenerate) choose the update as the rows evaluated on the fly do; and with the
-// stress points' share of the nodal stress (eq. (2.3.3)), whose interpolated stress both paths give.
-class V2OnTheFly : public ::testing::TestWithParam<std::pair<double, double>> {};
+// stress points' share of the nodal stress (eq. (2.3.3)), whose interpolated stress both paths give;
+// and with the nodal filters (the stress filter, eq. (2.3.4), and V1's velocity filter with the
+// Taylor-Galerkin update), which on the fly apply the weights steps 1 and 2 kept as they went.
+struct V2Variant {
+  double weight = 1.0, stress_weight = 0.0, stress_filter = 0.0;
+  StressFilterPart part = StressFilterPart::mean;
+  bool taylor_galerkin = false;
+};
+class V2OnTheFly : public ::testing::TestWithParam<V2Variant> {};
 
 TEST_P(V2OnTheFly, OperatorsOnTheFlyAgreeWithStoredOperators) {
   const test::ThreadCount threads(1);
-  const auto [weight, stress_weight] = GetParam();
-  auto run = [weight, stress_weight](bool on_the_fly) {
+  const V2Variant variant = GetParam();
+  auto run = [variant](bool on_the_fly) {
     VonMisesParameters vm;
     vm.elastic = ElasticConstants::from_E_nu(1.0e7, 0.3, 2000.0);
     vm.yield_stress = 2.0e4;
@@ -175,8 +182,14 @@ TEST_P(V2OnTheFly, OperatorsOnTheFlyAgreeWithStoredOperators) {
         .time(0.2, 0.5);
     CaseSetup<2> c = b.build();
     c.operators_on_the_fly = on_the_fly;
-    c.simple_weight = weight;
-    c.simple_stress_weight = stress_weight;
+    c.simple_weight = variant.weight;
+    c.simple_stress_weight = variant.stress_weight;
+    c.stress_filter = variant.stress_filter;
+    c.stress_filter_part = variant.part;
+    if (variant.taylor_galerkin) {
+      c.simple_velocity = false;
+      c.filter = true;
+    }
     auto sim = std::make_unique<Simulation<2>>(c);
     while (sim->time() < 0.2 - 1e-12) sim->step();
     return sim;
@@ -218,8 +231,11 @@ TEST_P(V2OnTheFly, OperatorsOnTheFlyAgreeWithStoredOperators) {
   EXPECT_LT(dx, 1e-12);
 }
 
-INSTANTIATE_TEST_SUITE_P(SimpleWeight, V2OnTheFly,
-                         ::testing::Values(std::pair{1.0, 0.0}, std::pair{0.5, 0.0}, std::pair{1.0, 0.2}));
+INSTANTIATE_TEST_SUITE_P(Variants, V2OnTheFly,
+                         ::testing::Values(V2Variant{}, V2Variant{.weight = 0.5}, V2Variant{.stress_weight = 0.2},
+                                           V2Variant{.weight = 0.5, .stress_filter = 0.5},
+                                           V2Variant{.stress_filter = 0.5, .part = StressFilterPart::full},
+                                           V2Variant{.taylor_galerkin = true}));
 
 // The Verlet lists (searched with a skin, kept while the particles move less than half of it)
 // give the operators of a fresh search at the current positions, bit for bit.
@@ -253,7 +269,7 @@ TEST(V2, VerletListsGiveTheOperatorsOfAFreshSearch) {
 
 // A collapsing block under gravity on a fixed base (V2, 3721 nodes: the loops run threaded):
 // one and two threads give the same bits, with and without the nodal stress filter (eq.
-// (2.3.4), on the stored operators); the mass of the continuity equation is kept.
+// (2.3.4), on the weights the steps keep on the fly); the mass of the continuity equation is kept.
 TEST(V2, OneAndTwoThreadsGiveBitIdenticalResultsAndTheMassIsKept) {
   for (const double stress_filter : {0.0, 0.5}) {
     auto run = [stress_filter](int threads) {
@@ -261,10 +277,7 @@ TEST(V2, OneAndTwoThreadsGiveBitIdenticalResultsAndTheMassIsKept) {
       CaseBuilder<2> b = block(2000.0, 2.0 / 60.0);
       b.gravity(Vec<2>(0.0, -9.81)).fix_velocity(Region<2>::plane(1, -1.0), {0, 1}).time(0.02, 0.5);
       CaseSetup<2> c = b.build();
-      if (stress_filter > 0.0) {
-        c.stress_filter = stress_filter;
-        c.operators_on_the_fly = false;
-      }
+      c.stress_filter = stress_filter;
       Simulation<2> sim(c);
       double m0 = 0.0;
       for (Index i = 0; i < sim.nodes().size(); ++i) m0 += sim.nodes().mass(i);

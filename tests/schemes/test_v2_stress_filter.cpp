@@ -21,7 +21,6 @@ namespace {
 CaseSetup<2> filtered(CaseSetup<2> c, double eps, StressFilterPart part = StressFilterPart::mean) {
   c.stress_filter = eps;
   c.stress_filter_part = part;
-  c.operators_on_the_fly = false;  // the filter applies the stored operators (the reader's choice)
   return c;
 }
 
