@@ -150,6 +150,8 @@ class Simulation {
   /// neighbours within the kernel's support (nodes and stress points), the nearest node and
   /// whether it is on the detected free surface. Computed only when a run is stopped.
   std::string fastest_node() const;
+  /// Stops the run (SolverError) when a node moved more than dx in the step of length dt from t.
+  void check_node_speeds(double t, double dt);
   /// The power of the loads: the boundary tractions and the scheme's extra power (bodies).
   double external_power();
 

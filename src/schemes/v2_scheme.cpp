@@ -16,6 +16,7 @@
 #include <chrono>
 #include <functional>
 #include <memory>
+#include <string>
 #include <utility>
 
 #include "schemes/deactivate_stage.hpp"
@@ -122,6 +123,14 @@ std::unique_ptr<Scheme> make_v2_scheme(StaggeredModel<Dim>& model) {
     }
   }
   if (surface != nullptr) scheme->add(std::make_unique<SurfaceTractionFree<Dim>>(*surface));
+  if (model.setup.stress_filter == 0.0) {
+    // What a run that goes unstable in a flow most often is (docs/VALIDATION.md, Case 9).
+    scheme->instability_hint = [] {
+      return std::string(
+          ". In a V2 flow a nodal stress mode that the stress points do not see can grow and throw nodes out: "
+          "solver.stress_filter = 0.5 damps it (method-notes eq. (2.3.4))");
+    };
+  }
   // Last but the re-seeding check: the particles outside the domain box frozen (and the ones
   // frozen before put back) on the step's final positions.
   if (model.setup.domain_box) scheme->add(std::make_unique<DeactivateOutside<Dim>>(model));
