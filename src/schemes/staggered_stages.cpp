@@ -6,6 +6,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <stdexcept>
 #include <utility>
 
 #include "io/state_archive.hpp"
@@ -721,6 +722,10 @@ void filter_nodal_checkerboard(const StaggeredModel<Dim>& m, const MovingOperato
   if (moving != nullptr && moving->on_the_fly) {
     if (!moving->record_interpolation)
       throw std::logic_error("nodal filter on the fly: the steps were not asked to record their interpolations");
+    // This step's rows: one a stress point and one a node (the scratch is sized by the sets).
+    if (moving->nodes_to_stress_points.rows() != m.stress_points.size() ||
+        moving->stress_points_to_nodes.rows() != m.nodes.size())
+      throw std::logic_error("nodal filter on the fly: the recorded rows are not this step's particles");
     const RecordedInterpolations<Dim> op{moving->nodes_to_stress_points, moving->stress_points_to_nodes};
     filter_nodal_checkerboard_with<Dim, NC>(m, op, field, at_sp, at_nodes, std::forward<Remove>(remove));
   } else {
