@@ -35,7 +35,7 @@ def main():
     with open(os.path.join(a.out, "fos.json")) as f:
         fos = json.load(f)
     lo, hi = fos["bracket"]
-    f_value = fos["factor_of_safety"]
+    f_value = fos.get("factor", fos.get("factor_of_safety"))
     ok = fos["status"] == "converged" and hi - lo <= fos["tolerance"] * lo * (1 + 1e-12)
     value = a.scale * f_value
     inside = a.low <= value <= a.high

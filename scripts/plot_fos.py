@@ -64,9 +64,10 @@ def main():
     ax_k.set_ylim(1e-6, 2.0)
     ax_k.set_xlabel("t (s)")
     ax_k.set_ylabel("kinetic energy / its peak")
-    f = fos.get("factor_of_safety")
+    f = fos.get("factor", fos.get("factor_of_safety"))
     lo, hi = fos["bracket"]
-    title = "F = {:.4f}, bracket [{}, {}]".format(f, lo, hi) if f is not None else "no factor: " + fos["status"]
+    name = "load factor" if fos.get("mode") == "load" else "F"
+    title = "{} = {:.4f}, bracket [{}, {}]".format(name, f, lo, hi) if f is not None else "no factor: " + fos["status"]
     ax_u.set_title(title)
     ax_k.set_title(os.path.basename(fos["case"]))
     ax_u.legend(fontsize=7, loc="upper left")

@@ -1,5 +1,6 @@
-// `rktsph fos CASE`: trials of the case at reduced strength, run in parallel when threads allow,
-// classified by the rule of docs/cases.md §1.3, searched by app/fos_search.cpp.
+// `rktsph fos CASE`: trials of the case at reduced strength (or at a multiplied load), run in
+// parallel when threads allow, classified by the rule of docs/cases.md §1.3, searched by
+// app/fos_search.cpp.
 #include "app/fos.hpp"
 
 #include <algorithm>
@@ -94,7 +95,7 @@ void classify(Trial& tr, const fos::Monitor& m) {
   std::vector<std::string> names = {"t", prefix + "ux"};
   if (m.direction.size() > 1) names.push_back(prefix + "uy");
   const auto probes = read_columns(tr.folder / "probes.csv", names);
-  const auto energy = read_columns(tr.folder / "energy.csv", {"t", "kinetic"});
+  const auto energy = read_columns(tr.folder / "energy.csv", {"t", m.kinetic_column});
   tr.t = probes[0];
   tr.u.assign(tr.t.size(), 0.0);
   for (std::size_t d = 0; d < m.direction.size(); ++d) {
@@ -141,12 +142,27 @@ void prepare_folder(const fs::path& out) {
   if (ec) throw InputError(io::system_error_text("create the output folder", out.string(), ec.value()));
 }
 
-nlohmann::json trial_json(const Trial& tr, const fs::path& out, const fos::StrengthReduction& strength) {
+// What a factor F changes in a trial: the strengths (divided by F) or the loads (times F).
+struct Scaling {
+  fos::FactorMode mode = fos::FactorMode::strength;
+  fos::StrengthReduction strength;
+  fos::LoadScaling load;
+  bool by_load() const { return mode == fos::FactorMode::load; }
+  std::vector<std::string> overrides(double f) const { return by_load() ? load.overrides(f) : strength.overrides(f); }
+  std::vector<std::pair<std::string, double>> values(double f) const {
+    return by_load() ? load.values(f) : strength.values(f);
+  }
+  // The factor's name in messages and in fos.json.
+  const char* name() const { return by_load() ? "load factor" : "factor of safety"; }
+  const char* key() const { return by_load() ? "load_factor" : "factor_of_safety"; }
+};
+
+nlohmann::json trial_json(const Trial& tr, const fs::path& out, const Scaling& scaling) {
   const auto& c = tr.classification;
   double u_max = 0.0;
   for (double u : tr.u) u_max = std::max(u_max, u);
-  nlohmann::json reduced = nlohmann::json::object();
-  for (const auto& [key, value] : strength.values(tr.factor)) reduced[key] = value;
+  nlohmann::json changed = nlohmann::json::object();
+  for (const auto& [key, value] : scaling.values(tr.factor)) changed[key] = value;
   nlohmann::json j = {
       {"index", tr.index},
       {"factor", tr.factor},
@@ -157,7 +173,7 @@ nlohmann::json trial_json(const Trial& tr, const fs::path& out, const fos::Stren
       {"history", fs::relative(tr.folder, out).string() + ".csv"},
       {"exit_code", tr.exit_code},
       {"seconds", tr.seconds},
-      {"reduced", reduced},
+      {scaling.by_load() ? "scaled" : "reduced", changed},
       {"u_c",
        {{"end", c.uc_end},
         {"max", u_max},
@@ -186,8 +202,14 @@ int run_fos(const FosOptions& opt) {
   // Everything is checked before a folder is touched: the case, its strengths, the [fos] table
   // and the monitored node.
   const CaseDocument doc = load_case_document(opt.case_file, case_overrides);
-  const fos::StrengthReduction strength = fos::read_strength(doc);
   fos::FosTable table = fos::read_fos_table(doc);
+  Scaling scaling;
+  scaling.mode = table.mode;
+  if (scaling.by_load()) {
+    scaling.load = fos::read_load_scaling(doc, table);
+  } else {
+    scaling.strength = fos::read_strength(doc);
+  }
   if (opt.tolerance > 0.0) table.search.tolerance = opt.tolerance;
   if (opt.max_trials > 0) table.search.max_trials = opt.max_trials;
   const fos::SearchSettings& settings = table.search;
@@ -209,11 +231,14 @@ int run_fos(const FosOptions& opt) {
   const int threads_per_trial = std::max(1, threads / jobs);
   if (!opt.quiet) {
     std::cerr << fmt::format(
-        "rktsph fos: {} ({}), monitor at [{}] along [{}] ({}), length {} m, window {} s; tolerance {} on F, at "
-        "most {} trials, {} at once ({} thread{} each)\n",
-        opt.case_file, solver_version, fmt::join(monitor.position, ", "), fmt::join(monitor.direction, ", "),
-        monitor.source, monitor.length, monitor.window, settings.tolerance, settings.max_trials, jobs,
-        threads_per_trial, threads_per_trial > 1 ? "s" : "");
+        "rktsph fos: {} ({}), {}, monitor at [{}] along [{}] ({}), length {} m, window {} s; tolerance {} on F, "
+        "at most {} trials, {} at once ({} thread{} each)\n",
+        opt.case_file, solver_version,
+        scaling.by_load() ? fmt::format("load factor on {}", fmt::join(table.load_functions, ", "))
+                          : std::string("strength reduction"),
+        fmt::join(monitor.position, ", "), fmt::join(monitor.direction, ", "), monitor.source, monitor.length,
+        monitor.window, settings.tolerance, settings.max_trials, jobs, threads_per_trial,
+        threads_per_trial > 1 ? "s" : "");
   }
 
   std::vector<Trial> trials;
@@ -231,8 +256,10 @@ int run_fos(const FosOptions& opt) {
     j["solver"] = solver_version;
     j["status"] = state;
     j["message"] = message;
+    j["mode"] = scaling.by_load() ? "load" : "strength";
     const double f = status.factor();
-    j["factor_of_safety"] = std::isfinite(f) ? nlohmann::json(f) : nlohmann::json(nullptr);
+    j["factor"] = std::isfinite(f) ? nlohmann::json(f) : nlohmann::json(nullptr);
+    j[scaling.key()] = j["factor"];
     j["bracket"] = {status.lo > 0.0 ? nlohmann::json(status.lo) : nlohmann::json(nullptr),
                     std::isfinite(status.hi) ? nlohmann::json(status.hi) : nlohmann::json(nullptr)};
     j["tolerance"] = settings.tolerance;
@@ -243,24 +270,30 @@ int run_fos(const FosOptions& opt) {
     j["jobs"] = jobs;
     j["threads_per_trial"] = threads_per_trial;
     j["non_monotone"] = non_monotone;
-    j["monitor"] = {{"position", monitor.position}, {"direction", monitor.direction}, {"length", monitor.length},
-                    {"window", monitor.window},     {"source", monitor.source}};
+    j["monitor"] = {{"position", monitor.position}, {"direction", monitor.direction},    {"length", monitor.length},
+                    {"window", monitor.window},     {"kinetic", monitor.kinetic_column}, {"source", monitor.source}};
     j["classification"] =
         "docs/cases.md §1.3 on u_c = u . direction at the monitored node, with H = length: stable if over the last "
         "window u_c changes by less than 1e-3 H and the kinetic energy stays below 1e-2 of its peak; collapse if u_c "
         "> 0.05 H or u_c still accelerates; otherwise undecided. Undecided and unstable trials count as not stable.";
-    nlohmann::json mats = nlohmann::json::array();
-    for (const auto& m : strength.materials) {
-      nlohmann::json e = {{"table", m.table}, {"model", m.model}};
-      for (const auto& [key, value] : m.divided) e["divided_by_F"][key] = value;
-      if (m.friction_angle) e["friction_angle"] = *m.friction_angle;
-      if (m.dilatancy) e["dilatancy"] = *m.dilatancy;
-      mats.push_back(e);
+    if (scaling.by_load()) {
+      nlohmann::json loads = nlohmann::json::object();
+      for (const auto& [table_name, scale] : scaling.load.functions) loads[table_name + ".scale"] = scale;
+      j["load_functions"] = loads;  // the unscaled scales; a trial at F has F times each
+    } else {
+      nlohmann::json mats = nlohmann::json::array();
+      for (const auto& m : scaling.strength.materials) {
+        nlohmann::json e = {{"table", m.table}, {"model", m.model}};
+        for (const auto& [key, value] : m.divided) e["divided_by_F"][key] = value;
+        if (m.friction_angle) e["friction_angle"] = *m.friction_angle;
+        if (m.dilatancy) e["dilatancy"] = *m.dilatancy;
+        mats.push_back(e);
+      }
+      j["strength"] = mats;
+      j["unreduced_materials"] = scaling.strength.unreduced;
     }
-    j["strength"] = mats;
-    j["unreduced_materials"] = strength.unreduced;
     j["trials"] = nlohmann::json::array();
-    for (const Trial& tr : trials) j["trials"].push_back(trial_json(tr, out, strength));
+    for (const Trial& tr : trials) j["trials"].push_back(trial_json(tr, out, scaling));
     j["wall_seconds"] = std::chrono::duration<double>(Clock::now() - t_start).count();
     io::write_file_atomically((out / "fos.json").string(), j.dump(2) + "\n");
   };
@@ -283,7 +316,7 @@ int run_fos(const FosOptions& opt) {
       tr.factor = f;
       tr.folder = out / fmt::format("trial_{:02d}", tr.index);
       tr.overrides = base;
-      for (const std::string& o : strength.overrides(f)) tr.overrides.push_back(o);
+      for (const std::string& o : scaling.overrides(f)) tr.overrides.push_back(o);
       trials.push_back(std::move(tr));
     }
     if (!opt.quiet) {
@@ -376,15 +409,19 @@ int run_fos(const FosOptions& opt) {
   const Trial* first_trial = trials.empty() ? nullptr : &trials.front();
   switch (status.state) {
     case fos::SearchState::converged:
-      message = fmt::format("F = {:.4f}, bracket [{:.4f}, {:.4f}] (tolerance {} relative), {} trials used, {} run",
-                            status.factor(), status.lo, status.hi, settings.tolerance, path.size(), trials.size());
+      message = fmt::format("{} F = {:.4f}, bracket [{:.4f}, {:.4f}] (tolerance {} relative), {} trials used, {} run",
+                            scaling.name(), status.factor(), status.lo, status.hi, settings.tolerance, path.size(),
+                            trials.size());
       break;
     case fos::SearchState::unreduced_fails:
       message = fmt::format(
-          "rktsph fos: the unreduced case (F = {}) does not stand: trial 1 is {} (u_c = {:.4g} m = {:.3g} L at the "
-          "end); strength reduction looks for F >= 1 only; the trial is kept in {}",
-          settings.start, first_trial->outcome, first_trial->classification.uc_end,
-          first_trial->classification.uc_end / monitor.length, first_trial->folder.string());
+          "rktsph fos: the {} (F = {}) does not stand: trial 1 is {} (u_c = {:.4g} m = {:.3g} L at the end); {}; "
+          "the trial is kept in {}",
+          scaling.by_load() ? "case at its nominal load" : "unreduced case", settings.start, first_trial->outcome,
+          first_trial->classification.uc_end, first_trial->classification.uc_end / monitor.length,
+          scaling.by_load() ? "the load factor is searched from F = 1 up: give a nominal load the body carries"
+                            : "strength reduction looks for F >= 1 only",
+          first_trial->folder.string());
       code = kExitNoFactor;
       break;
     default:

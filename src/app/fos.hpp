@@ -1,8 +1,10 @@
 #pragma once
-// `rktsph fos CASE`: the factor of safety by strength reduction (docs/fos.md, method-notes §10).
-// Each trial is the case run with its strengths divided by a factor F (app/fos_setup.hpp), in
-// its own output folder, and classified stable / collapse by the rule of docs/cases.md §1.3 on
-// the monitored displacement; the search (app/fos_search.hpp) brackets and bisects F.
+// `rktsph fos CASE`: the factor of safety by strength reduction (docs/fos.md, method-notes §10),
+// or with fos.mode = "load" the load factor of the collapse load. Each trial is the case run
+// with its strengths divided by a factor F, or its named loads multiplied by F
+// (app/fos_setup.hpp), in its own output folder, and classified stable / collapse by the rule of
+// docs/cases.md §1.3 on the monitored displacement; the search (app/fos_search.hpp) brackets and
+// bisects F.
 #include <string>
 #include <vector>
 

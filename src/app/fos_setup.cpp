@@ -43,6 +43,19 @@ std::vector<std::string> StrengthReduction::overrides(double factor) const {
   return out;
 }
 
+std::vector<std::pair<std::string, double>> LoadScaling::values(double factor) const {
+  // method-notes eq. (10.4): every load a named function scales, times F.
+  std::vector<std::pair<std::string, double>> out;
+  for (const auto& [table, scale] : functions) out.emplace_back(table + ".scale", scale * factor);
+  return out;
+}
+
+std::vector<std::string> LoadScaling::overrides(double factor) const {
+  std::vector<std::string> out;
+  for (const auto& [key, value] : values(factor)) out.push_back(fmt::format("{}={}", key, value));
+  return out;
+}
+
 namespace {
 
 std::optional<double> number_of(const toml::table& t, const char* key) {
@@ -117,6 +130,25 @@ FosTable read_fos_table(const CaseDocument& doc) {
   f.where = root.where("fos");
   const auto s = root.optional_table("fos");
   if (!s) return f;
+  const std::string mode = s->string("mode", "strength");
+  if (mode == "load") {
+    f.mode = FactorMode::load;
+  } else if (mode != "strength") {
+    s->fail("mode", fmt::format("unknown mode '{}': \"strength\" (the factor of safety by strength reduction) or "
+                                "\"load\" (the load factor of the collapse load)",
+                                mode));
+  }
+  if (s->has("load_functions")) {
+    if (f.mode != FactorMode::load) {
+      s->fail("load_functions", "the time functions of the loads are scaled only with mode = \"load\"");
+    }
+    f.load_functions = s->strings("load_functions");
+    s->require(!f.load_functions.empty(), "load_functions", "name at least one time function");
+  } else if (f.mode == FactorMode::load) {
+    s->fail("mode",
+            "mode = \"load\" needs load_functions: the names of the [functions.NAME] tables whose loads the "
+            "factor multiplies, e.g. load_functions = [\"load\"]");
+  }
   if (s->has("monitor")) {
     const toml::node* n = s->raw().get("monitor");
     if (n->is_string()) {
@@ -136,6 +168,12 @@ FosTable read_fos_table(const CaseDocument& doc) {
   }
   if (s->has("length")) f.length = s->positive("length");
   f.window = s->positive("window", 1.0);
+  const std::string kinetic = s->string("kinetic", "nodes");
+  if (kinetic == "stress_points") {
+    f.kinetic_of_stress_points = true;
+  } else if (kinetic != "nodes") {
+    s->fail("kinetic", fmt::format("unknown kinetic energy '{}': \"nodes\" or \"stress_points\"", kinetic));
+  }
   f.search.tolerance = s->positive("tolerance", f.search.tolerance);
   s->require(f.search.tolerance < 1.0, "tolerance",
              fmt::format("the relative tolerance on F must be below 1, got {}", f.search.tolerance));
@@ -147,6 +185,32 @@ FosTable read_fos_table(const CaseDocument& doc) {
              fmt::format("the expansion factor must lie in (1, 10], got {}", f.search.growth));
   s->finish();
   return f;
+}
+
+LoadScaling read_load_scaling(const CaseDocument& doc, const FosTable& table) {
+  LoadScaling out;
+  const io::Section root(doc.table, "", doc.file_label);
+  const auto functions = root.optional_table("functions");
+  for (const std::string& name : table.load_functions) {
+    if (!functions || !functions->has(name)) {
+      const std::vector<std::string> names = functions ? functions->keys() : std::vector<std::string>{};
+      root.table("fos").fail(
+          "load_functions",
+          fmt::format("no time function '{}' in the case (its functions: {}); a load to be scaled needs a "
+                      "[functions.NAME] table and `function = \"NAME\"` on its [[boundary]] entries",
+                      name, names.empty() ? std::string("none") : fmt::format("{}", fmt::join(names, ", "))));
+    }
+    if (name.find('.') != std::string::npos) {
+      root.table("fos").fail("load_functions",
+                             fmt::format("the function name '{}' has a dot: it cannot be overridden (--set splits "
+                                         "keys at dots)",
+                                         name));
+    }
+    const io::Section f = functions->table(name);
+    const double scale = number_of(f.raw(), "scale").value_or(1.0);
+    out.functions.emplace_back("functions." + name, scale);
+  }
+  return out;
 }
 
 namespace {
@@ -164,6 +228,7 @@ Monitor resolve(const CaseDocument& doc, const FosTable& f) {
   };
   Monitor m;
   m.window = f.window;
+  m.kinetic_column = f.kinetic_of_stress_points ? "kinetic_stress_points" : "kinetic";
   if (!(f.window < setup.end_time)) {
     fail("window", fmt::format("the classification window ({} s) must be shorter than time.end ({} s)", f.window,
                                setup.end_time));

@@ -1,7 +1,8 @@
 #pragma once
 // What `rktsph fos` reads from a case (docs/fos.md): the strength keys of its materials and how a
-// factor F reduces them (method-notes §10, eq. (10.1)), the [fos] table (monitor, reference
-// length, classification window, search settings) and the monitored node.
+// factor F reduces them (method-notes §10, eq. (10.1)), or the time functions of the loads a load
+// factor F multiplies (eq. (10.4)); the [fos] table (what F scales, monitor, reference length,
+// classification window, search settings) and the monitored node.
 #include <optional>
 #include <string>
 #include <utility>
@@ -40,17 +41,43 @@ StrengthReduction read_strength(const CaseDocument& doc);
 /// phi_F = atan(tan(phi) / F), degrees in and out (method-notes eq. (10.1)).
 double reduced_friction_angle(double phi_degrees, double factor);
 
+/// What a trial's factor F scales: the strengths, divided by F (the factor of safety by strength
+/// reduction), or the loads, multiplied by F (the load factor of the collapse load).
+enum class FactorMode { strength, load };
+
+/// The load factor (method-notes eq. (10.4)): a trial at F multiplies the `scale` of each named
+/// time function (every load the function scales) by F.
+struct LoadScaling {
+  /// "functions.NAME" and its unscaled `scale` (default 1).
+  std::vector<std::pair<std::string, double>> functions;
+  /// The --set overrides that give the case at load factor F.
+  std::vector<std::string> overrides(double factor) const;
+  /// The scaled values at F, as "functions.NAME.scale" -> value.
+  std::vector<std::pair<std::string, double>> values(double factor) const;
+};
+
 /// The [fos] table (every key optional).
 struct FosTable {
+  FactorMode mode = FactorMode::strength;            // mode = "strength" | "load"
+  std::vector<std::string> load_functions;           // load_functions = ["NAME", ...] (mode "load")
   std::optional<std::string> monitor_probe;          // monitor = "probe name"
   std::optional<std::vector<double>> monitor_point;  // monitor = [x, y]
   std::optional<std::vector<double>> direction;      // unit vector of the monitored displacement
   std::optional<double> length;                      // m: H of a cut, B of a footing
   double window = 1.0;                               // s: the classification window
+  /// kinetic = "nodes" (default) | "stress_points": whose kinetic energy the classification
+  /// reads (energy.csv's `kinetic` or `kinetic_stress_points`).
+  bool kinetic_of_stress_points = false;
   SearchSettings search;
   std::string where;  // "case.toml, line N, key 'fos'" for messages
 };
+/// InputError (file, line, key) for an unknown mode, load_functions without mode = "load" or
+/// missing with it.
 FosTable read_fos_table(const CaseDocument& doc);
+
+/// The time functions of fos.load_functions with their scales; InputError (file, line, key
+/// 'fos.load_functions') for a name that is not a [functions.NAME] table of the case.
+LoadScaling read_load_scaling(const CaseDocument& doc, const FosTable& table);
 
 /// The monitored node and the classification's scales, resolved on the case's particles.
 struct Monitor {
@@ -58,6 +85,7 @@ struct Monitor {
   std::vector<double> direction;  // unit vector; u_c = u . direction
   double length = 0.0;            // m
   double window = 1.0;            // s
+  std::string kinetic_column = "kinetic";  // energy.csv's column the classification reads
   std::string source;             // how it was chosen, for the report
 };
 /// InputError (file, line, key 'fos.monitor') when the probe is not in the case or the point

@@ -179,7 +179,9 @@ int main(int argc, char** argv) {
 
   FosOptions fos;
   auto* fos_cmd = app.add_subcommand(
-      "fos", "Factor of safety by strength reduction: trials at c/F, tan(phi)/F, bisected on F (fos.json + plot)");
+      "fos",
+      "Factor of safety by strength reduction (trials at c/F, tan(phi)/F), or with fos.mode = \"load\" the load factor "
+      "of the collapse load (trials at F times the loads); bisected on F (fos.json + plot)");
   fos_cmd->add_option("case", fos.case_file, "Case file (TOML; its [fos] table: docs/case-format.md)")
       ->required()
       ->check(CLI::ExistingFile);

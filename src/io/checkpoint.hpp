@@ -11,7 +11,9 @@
 namespace rktsph::io {
 
 /// The format of the checkpoint files this program writes and reads.
-inline constexpr int kCheckpointFormat = 2;  // 2: the sets' fingerprints as made from the case
+// 2: the sets' fingerprints as made from the case; 3: energy.csv gained its column
+// kinetic_stress_points (a run of format 2 resumed would append rows longer than its header).
+inline constexpr int kCheckpointFormat = 3;
 
 void write_checkpoint(const std::string& path, const StateArchive& archive);
 StateArchive read_checkpoint(const std::string& path);

@@ -2,12 +2,14 @@
 // von Mises, N = gamma H / c = 3.4, whose factor must bracket the limit-analysis N_c (~3.78)
 // within what so coarse a lattice resolves; and every error path (no strength to reduce, a
 // monitor that is missing, an unreduced run that does not stand, a bracket that does not close)
-// stops with its message or exit status and keeps the trials it ran.
+// stops with its message or exit status and keeps the trials it ran. The load factor
+// (fos.mode = "load") on a tiny strip load against Prandtl, and its input errors.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <numbers>
 #include <string>
 
 #include <nlohmann/json.hpp>
@@ -290,6 +292,146 @@ TEST(FosRun, BracketThatDoesNotCloseKeepsItsTrials) {
   o.jobs = 1;
   EXPECT_EQ(run_fos(o), kExitNoFactor);
   EXPECT_FALSE(fs::exists(out / "trial_02"));
+}
+
+// A weightless von Mises block, 3 m x 1.5 m at dx = 0.25 m, under a smooth rigid strip footing
+// pushed by a force (load control, method-notes §4.6) on the half-width B/2 = 0.5 m (symmetry at
+// x = 0): nominal 150 kPa (75 kN/m on the half), c = 50 kPa, so that Prandtl's (2 + pi) c =
+// 257.08 kPa is a load factor of 1.7139. The classification reads the stress points' kinetic
+// energy: the nodes keep a steady velocity beside the footing's edge that the stress points do
+// not see (method-notes §5.1, "Displacements"; here 28 % of the nodes' peak at rest, against
+// 1e-4 on the stress points), and no trial would ever stand on the nodes' energy.
+const char* kStripLoad = R"(
+title = "tiny strip load for the load factor of rktsph fos"
+[geometry]
+dimension = 2
+spacing = 0.25
+[[geometry.block]]
+min = [0.0, 0.0]
+max = [3.0, 1.5]
+[material]
+model = "perzyna_von_mises"
+E = 5.0e7
+nu = 0.3
+density = 2000.0
+cohesion = 50.0e3
+fluidity = 10.0
+[functions.load]
+type = "ramp"
+duration = 0.3
+scale = -75.0e3
+[damping]
+coefficient = 5.0
+until_kinetic_ratio = 1.0e-3
+kinetic_ratio_from = 0.3
+kinetic_ratio_hold = 0.2
+until = 1.0
+[[boundary]]
+name = "symmetry"
+x = [0.0, 0.0]
+velocity = { x = 0.0 }
+[[boundary]]
+name = "far_side"
+x = [3.0, 3.0]
+velocity = { x = 0.0 }
+[[boundary]]
+name = "base"
+y = [0.0, 0.0]
+velocity = { x = 0.0, y = 0.0 }
+[[body]]
+name = "footing"
+segment = { a = [0.5, 1.5], b = [0.0, 1.5] }
+contact = "smooth"
+force = { y = "load" }
+mass = 500.0
+[time]
+end = 2.3
+cfl = 0.3
+[output]
+interval = 0.0
+elements = false
+[[probe]]
+name = "centre"
+position = [0.0, 1.5]
+fields = ["uy"]
+[fos]
+mode = "load"
+load_functions = ["load"]
+monitor = "centre"
+direction = [0.0, -1.0]
+length = 1.0
+kinetic = "stress_points"
+)";
+
+TEST(FosRun, LoadFactorOfATinyStripLoadBracketsPrandtl) {
+  test::TempDir dir;
+  const std::string file = dir.write("strip.toml", kStripLoad);
+  const fs::path out = dir.path() / "fos";
+  ASSERT_EQ(run_fos(options(file, out)), 0);
+  const nlohmann::json j = read_json(out / "fos.json");
+  EXPECT_EQ(j["status"], "converged");
+  EXPECT_EQ(j["mode"], "load");
+  EXPECT_TRUE(j["factor_of_safety"].is_null() || !j.contains("factor_of_safety"));
+  const double f = j["load_factor"], lo = j["bracket"][0], hi = j["bracket"][1];
+  EXPECT_DOUBLE_EQ(j["factor"].get<double>(), f);
+  EXPECT_LE(hi - lo, 0.05 * lo);
+  // The collapse pressure 150 kPa x F against (2 + pi) c, with two cells under the half-width and
+  // V1's static deficit under a held rigid footing (docs/VALIDATION.md, "Bearing capacity of c–φ
+  // soil": 0.79 q_u at B/10 on c–φ soil): a band around what this lattice gives, below Prandtl.
+  const double prandtl = (2.0 + std::numbers::pi) * 50.0e3 / 150.0e3;
+  EXPECT_GT(lo, 0.6 * prandtl);
+  EXPECT_LT(hi, 1.05 * prandtl);
+  EXPECT_DOUBLE_EQ(j["load_functions"]["functions.load.scale"].get<double>(), -75.0e3);
+  for (const auto& t : j["trials"]) {
+    // Each trial multiplies the function's own scale by F.
+    EXPECT_DOUBLE_EQ(t["scaled"]["functions.load.scale"].get<double>(), -75.0e3 * t["factor"].get<double>());
+    if (!t["used"]) continue;
+    EXPECT_EQ(t["stable"].get<bool>(), t["factor"].get<double>() <= lo) << t["factor"];
+  }
+}
+
+TEST(FosRun, LoadFactorInputErrors) {
+  test::TempDir dir;
+  auto expect_input_error = [&](const std::string& from, const std::string& to, const std::string& what) {
+    std::string text = kStripLoad;
+    const auto at = text.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    text.replace(at, from.size(), to);
+    const std::string file = dir.write("bad.toml", text);
+    try {
+      (void)run_fos(options(file, dir.path() / "fos"));
+      ADD_FAILURE() << "no error for " << to;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("bad.toml, line"), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(fs::exists(dir.path() / "fos")) << "nothing is written before the input is checked";
+  };
+  expect_input_error("mode = \"load\"", "mode = \"loads\"", "unknown mode 'loads'");
+  expect_input_error("load_functions = [\"load\"]", "", "mode = \"load\" needs load_functions");
+  expect_input_error("load_functions = [\"load\"]", "load_functions = [\"push\"]",
+                     "no time function 'push' in the case (its functions: load)");
+  expect_input_error("kinetic = \"stress_points\"", "kinetic = \"fluid\"",
+                     "unknown kinetic energy 'fluid': \"nodes\" or \"stress_points\"");
+  expect_input_error("mode = \"load\"", "mode = \"strength\"",
+                     "the time functions of the loads are scaled only with mode = \"load\"");
+  // An all-elastic body has no strength to reduce, but its load can be scaled: the search then
+  // never sees a collapse and says so (exit status 5), after the trials it was allowed.
+  std::string elastic = kStripLoad;
+  auto replace = [&](const std::string& from, const std::string& to) {
+    elastic.replace(elastic.find(from), from.size(), to);
+  };
+  replace("model = \"perzyna_von_mises\"", "model = \"elastic\"");
+  replace("cohesion = 50.0e3", "");
+  replace("fluidity = 10.0", "");
+  const std::string file = dir.write("elastic.toml", elastic);
+  FosOptions o = options(file, dir.path() / "fos_elastic");
+  o.max_trials = 2;
+  o.jobs = 1;
+  EXPECT_EQ(run_fos(o), kExitNoFactor);
+  const nlohmann::json j = read_json(dir.path() / "fos_elastic" / "fos.json");
+  EXPECT_EQ(j["status"], "bracket_open");
+  EXPECT_TRUE(j["load_factor"].is_null());
 }
 
 }  // namespace
