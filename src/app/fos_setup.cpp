@@ -15,6 +15,19 @@
 
 namespace rktsph::fos {
 
+namespace {
+
+/// A trial's values reach the case through `--set TABLE.NAME.KEY`, which splits keys at dots: a
+/// name with a dot could not be overridden, so it is refused where it is named.
+void refuse_dotted_name(const io::Section& section, const std::string& key, const char* kind, const std::string& name) {
+  if (name.find('.') == std::string::npos) return;
+  section.fail(key, fmt::format("rktsph fos: the {} name '{}' has a dot: it cannot be overridden (--set splits "
+                                "keys at dots)",
+                                kind, name));
+}
+
+}  // namespace
+
 double reduced_friction_angle(double phi_degrees, double factor) {
   constexpr double kDeg = std::numbers::pi / 180.0;
   return std::atan(std::tan(phi_degrees * kDeg) / factor) / kDeg;
@@ -109,9 +122,7 @@ StrengthReduction read_strength(const CaseDocument& doc) {
   } else {
     const io::Section ms = root.table("materials");
     for (const std::string& name : ms.keys()) {
-      if (name.find('.') != std::string::npos) {
-        ms.fail(name, "rktsph fos: a material name with a dot cannot be overridden (--set splits keys at dots)");
-      }
+      refuse_dotted_name(ms, name, "material", name);
       add_material(ms.table(name), out);
     }
   }
@@ -200,12 +211,7 @@ LoadScaling read_load_scaling(const CaseDocument& doc, const FosTable& table) {
                       "[functions.NAME] table and `function = \"NAME\"` on its [[boundary]] entries",
                       name, names.empty() ? std::string("none") : fmt::format("{}", fmt::join(names, ", "))));
     }
-    if (name.find('.') != std::string::npos) {
-      root.table("fos").fail("load_functions",
-                             fmt::format("the function name '{}' has a dot: it cannot be overridden (--set splits "
-                                         "keys at dots)",
-                                         name));
-    }
+    refuse_dotted_name(root.table("fos"), "load_functions", "function", name);
     const io::Section f = functions->table(name);
     const double scale = number_of(f.raw(), "scale").value_or(1.0);
     out.functions.emplace_back("functions." + name, scale);

@@ -372,19 +372,9 @@ int run_loop(const LoopInput& in) {
                       "reduce the time step (time.cfl = {:.3g}) or check the loads and material parameters",
                       solver.time(), solver.step_count(), solver.cfl()));
     }
-    // The stress points' kinetic energy beside the nodes': the stress points do not carry the
-    // steady nodal velocity of a body at rest under a load edge (method-notes §5.1,
-    // "Displacements"), so it tells a body at rest from one still moving (`fos.kinetic`).
-    double kinetic_sp = 0.0;
-    const auto v_sp = solver.stress_point_velocity();
-    for (Index k = 0; k < solver.stress_points().size(); ++k) {
-      double v2 = 0.0;
-      for (int d = 0; d < Dim; ++d) v2 += v_sp(k, d) * v_sp(k, d);
-      kinetic_sp += 0.5 * solver.stress_points().mass(k) * v2;
-    }
     energy_csv.append(fmt::format("{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g}\n", solver.time(), e.kinetic,
                                   e.strain - e.initial_strain, e.external_work, e.damping_loss, e.imbalance(),
-                                  kinetic_sp));
+                                  e.kinetic_stress_points));
   };
   auto write_frame = [&] {
     // The current positions (they move in a large-deformation scheme).

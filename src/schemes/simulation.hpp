@@ -4,6 +4,7 @@
 // as written in method-notes §5: the scheme's stages in order, then the step's balance
 // (momentum, kinetic energy, a non-finite check), the energy account and the growth guard.
 #include <algorithm>
+#include <limits>
 #include <memory>
 #include <span>
 #include <string>
@@ -145,13 +146,17 @@ class Simulation {
   void choose_step(double t);
   /// A step from the current state this far below the initial one stops the run.
   static constexpr double kSmallestStepRatio = 1e-3;
-  StepSums<Dim> balance_sums();
+  /// The end of step's sums; nodes with |v|^2 > speed_limit2 are counted (none at infinity).
+  StepSums<Dim> balance_sums(double speed_limit2 = std::numeric_limits<double>::infinity());
   /// Where a growth shows first, for the growth guard's message: the fastest node, its
   /// neighbours within the kernel's support (nodes and stress points), the nearest node and
   /// whether it is on the detected free surface. Computed only when a run is stopped.
   std::string fastest_node() const;
-  /// Stops the run (SolverError) when a node moved more than dx in the step of length dt from t.
-  void check_node_speeds(double t, double dt);
+  /// |v|^2 above which a node moves more than dx in a step of length dt (infinity where the case
+  /// fixes the step: time.dt may be meant to outrun the waves).
+  double speed_limit2(double dt) const;
+  /// Stops the run (SolverError) when `fast` nodes moved more than dx in the step of length dt from t.
+  void check_node_speeds(double t, double dt, double fast);
   /// The power of the loads: the boundary tractions and the scheme's extra power (bodies).
   double external_power();
 

@@ -16,6 +16,10 @@ namespace rktsph {
 
 struct EnergyBalance {
   double kinetic = 0.0;         // J (per unit thickness in 2D, per unit area in 1D)
+  /// The stress points' kinetic energy, 1/2 sum m_E |v_E|^2 at t^{n+1/2}, J: they do not carry
+  /// the steady nodal velocity of a body at rest under a load edge (method-notes §5.1,
+  /// "Displacements"), so it tells a body at rest from one still moving (`fos.kinetic`).
+  double kinetic_stress_points = 0.0;
   double strain = 0.0;          // stored energy: elastic 1/2 sigma : C^-1 : sigma (+ fluid storage in V3), J
   double external_work = 0.0;   // work of boundary tractions and body forces since t = 0, J
   double damping_loss = 0.0;    // energy removed by the velocity damping, J
@@ -24,10 +28,11 @@ struct EnergyBalance {
   double imbalance() const { return kinetic + strain - initial_strain - external_work + damping_loss; }
 };
 
-/// What the end of a step needs from the particles: momentum (Dim), sum m v^2, and a flag set
-/// when a velocity is not finite. Summed by one deterministic reduction (core/execution.hpp).
+/// What the end of a step needs from the particles: momentum (Dim), sum m v^2, a flag set when a
+/// velocity is not finite, and the number of nodes faster than the step resolves (|v| dt > dx).
+/// Summed by one deterministic reduction (core/execution.hpp).
 template <int Dim>
-using StepSums = std::array<double, Dim + 2>;
+using StepSums = std::array<double, Dim + 3>;
 
 template <int Dim>
 class TimeControl {
