@@ -231,9 +231,9 @@ int run_fos(const FosOptions& opt) {
   const int threads_per_trial = std::max(1, threads / jobs);
   if (!opt.quiet) {
     std::cerr << fmt::format(
-        "rktsph fos: {} ({}), {}, monitor at [{}] along [{}] ({}), length {} m, window {} s; tolerance {} on F, "
-        "at most {} trials, {} at once ({} thread{} each)\n",
-        opt.case_file, solver_version,
+        "rktsph fos: {} ({}, dx = {:.4g} m, h = {:.4g} m), {}, monitor at [{}] along [{}] ({}), length {} m, window "
+        "{} s; tolerance {} on F, at most {} trials, {} at once ({} thread{} each)\n",
+        opt.case_file, solver_version, monitor.spacing, monitor.smoothing_length,
         scaling.by_load() ? fmt::format("load factor on {}", fmt::join(table.load_functions, ", "))
                           : std::string("strength reduction"),
         fmt::join(monitor.position, ", "), fmt::join(monitor.direction, ", "), monitor.source, monitor.length,
@@ -270,6 +270,8 @@ int run_fos(const FosOptions& opt) {
     j["jobs"] = jobs;
     j["threads_per_trial"] = threads_per_trial;
     j["non_monotone"] = non_monotone;
+    j["spacing"] = monitor.spacing;
+    j["smoothing_length"] = monitor.smoothing_length;
     j["monitor"] = {{"position", monitor.position}, {"direction", monitor.direction},    {"length", monitor.length},
                     {"window", monitor.window},     {"kinetic", monitor.kinetic_column}, {"source", monitor.source}};
     j["classification"] =

@@ -87,6 +87,10 @@ struct Monitor {
   double window = 1.0;            // s
   std::string kinetic_column = "kinetic";  // energy.csv's column the classification reads
   std::string source;             // how it was chosen, for the report
+  // The case's resolution, for the report: a limit load converges with the smoothing length h,
+  // not the spacing alone (docs/fos.md, "Resolution").
+  double spacing = 0.0;           // m
+  double smoothing_length = 0.0;  // m
 };
 /// InputError (file, line, key 'fos.monitor') when the probe is not in the case or the point
 /// is not on the body.

@@ -374,6 +374,9 @@ TEST(FosRun, LoadFactorOfATinyStripLoadBracketsPrandtl) {
   const nlohmann::json j = read_json(out / "fos.json");
   EXPECT_EQ(j["status"], "converged");
   EXPECT_EQ(j["mode"], "load");
+  // The resolution the factor belongs to (spacing 0.25 m, the default h = 1.2 dx).
+  EXPECT_DOUBLE_EQ(j["spacing"].get<double>(), 0.25);
+  EXPECT_DOUBLE_EQ(j["smoothing_length"].get<double>(), 1.2 * 0.25);
   EXPECT_TRUE(j["factor_of_safety"].is_null() || !j.contains("factor_of_safety"));
   const double f = j["load_factor"], lo = j["bracket"][0], hi = j["bracket"][1];
   EXPECT_DOUBLE_EQ(j["factor"].get<double>(), f);
