@@ -419,20 +419,26 @@ TEST(FosRun, LoadFactorOfATinyStripLoadBracketsPrandtl) {
 
 TEST(FosRun, LoadFactorInputErrors) {
   test::TempDir dir;
-  auto expect_input_error = [&](const std::string& from, const std::string& to, const std::string& what) {
+  using Edits = std::vector<std::pair<std::string, std::string>>;
+  auto expect_input_error_after = [&](const Edits& edits, const std::string& what) {
     std::string text = kStripLoad;
-    const auto at = text.find(from);
-    ASSERT_NE(at, std::string::npos) << from;
-    text.replace(at, from.size(), to);
+    for (const auto& [from, to] : edits) {
+      const auto at = text.find(from);
+      ASSERT_NE(at, std::string::npos) << from;
+      text.replace(at, from.size(), to);
+    }
     const std::string file = dir.write("bad.toml", text);
     try {
       (void)run_fos(options(file, dir.path() / "fos"));
-      ADD_FAILURE() << "no error for " << to;
+      ADD_FAILURE() << "no error for " << edits.back().second;
     } catch (const InputError& e) {
       EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
       EXPECT_NE(std::string(e.what()).find("bad.toml, line"), std::string::npos) << e.what();
     }
     EXPECT_FALSE(fs::exists(dir.path() / "fos")) << "nothing is written before the input is checked";
+  };
+  auto expect_input_error = [&](const std::string& from, const std::string& to, const std::string& what) {
+    expect_input_error_after({{from, to}}, what);
   };
   expect_input_error("mode = \"load\"", "mode = \"loads\"", "unknown mode 'loads'");
   expect_input_error("load_functions = [\"load\"]", "", "mode = \"load\" needs load_functions");
@@ -442,25 +448,11 @@ TEST(FosRun, LoadFactorInputErrors) {
                      "unknown kinetic energy 'fluid': \"nodes\" or \"stress_points\"");
   expect_input_error("mode = \"load\"", "mode = \"strength\"",
                      "the time functions of the loads are scaled only with mode = \"load\"");
-  {
-    // A trial reaches the function through --set functions.NAME.scale, split at dots.
-    std::string dotted = kStripLoad;
-    for (const auto& [from, to] : {std::pair<std::string, std::string>{"[functions.load]", "[functions.\"lo.ad\"]"},
-                                   {"force = { y = \"load\" }", "force = { y = \"lo.ad\" }"},
-                                   {"load_functions = [\"load\"]", "load_functions = [\"lo.ad\"]"}}) {
-      const auto at = dotted.find(from);
-      ASSERT_NE(at, std::string::npos) << from;
-      dotted.replace(at, from.size(), to);
-    }
-    const std::string file = dir.write("dotted.toml", dotted);
-    try {
-      (void)run_fos(options(file, dir.path() / "fos_dotted"));
-      ADD_FAILURE() << "no error for a dotted function name";
-    } catch (const InputError& e) {
-      EXPECT_NE(std::string(e.what()).find("the function name 'lo.ad' has a dot"), std::string::npos) << e.what();
-      EXPECT_NE(std::string(e.what()).find("load_functions"), std::string::npos) << e.what();
-    }
-  }
+  // A trial reaches the function through --set functions.NAME.scale, split at dots.
+  expect_input_error_after({{"[functions.load]", "[functions.\"lo.ad\"]"},
+                            {"force = { y = \"load\" }", "force = { y = \"lo.ad\" }"},
+                            {"load_functions = [\"load\"]", "load_functions = [\"lo.ad\"]"}},
+                           "the function name 'lo.ad' has a dot");
   // An all-elastic body has no strength to reduce, but its load can be scaled: the search then
   // never sees a collapse and says so (exit status 5), after the trials it was allowed.
   std::string elastic = kStripLoad;
