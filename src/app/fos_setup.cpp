@@ -48,13 +48,19 @@ std::vector<std::pair<std::string, double>> StrengthReduction::values(double fac
   return out;
 }
 
-std::vector<std::string> StrengthReduction::overrides(double factor) const {
+namespace {
+
+/// The --set overrides "KEY=VALUE" of a trial's values: the shortest text that reads back as the
+/// same double (an integer-looking one is a TOML integer, which the reader takes as a number too).
+std::vector<std::string> as_overrides(const std::vector<std::pair<std::string, double>>& values) {
   std::vector<std::string> out;
-  // The shortest text that reads back as the same double (an integer-looking one is a TOML
-  // integer, which the reader takes as a number too).
-  for (const auto& [key, value] : values(factor)) out.push_back(fmt::format("{}={}", key, value));
+  for (const auto& [key, value] : values) out.push_back(fmt::format("{}={}", key, value));
   return out;
 }
+
+}  // namespace
+
+std::vector<std::string> StrengthReduction::overrides(double factor) const { return as_overrides(values(factor)); }
 
 std::vector<std::pair<std::string, double>> LoadScaling::values(double factor) const {
   // method-notes eq. (10.4): every load a named function scales, times F.
@@ -63,11 +69,7 @@ std::vector<std::pair<std::string, double>> LoadScaling::values(double factor) c
   return out;
 }
 
-std::vector<std::string> LoadScaling::overrides(double factor) const {
-  std::vector<std::string> out;
-  for (const auto& [key, value] : values(factor)) out.push_back(fmt::format("{}={}", key, value));
-  return out;
-}
+std::vector<std::string> LoadScaling::overrides(double factor) const { return as_overrides(values(factor)); }
 
 namespace {
 
