@@ -35,6 +35,17 @@ add_test(NAME fos_quick
                  -- --set geometry.spacing=0.5 --tol 0.02 --jobs 2 --threads 2 --quiet)
 set_tests_properties(fos_quick PROPERTIES LABELS validation PROCESSORS 2 TIMEOUT 600)
 
+# The same search in the large-deformation solver (`--solver v2`) on Case 12's soil under a
+# flexible 200 kPa (cases/examples/strip_footing_fos_2d.toml) at B/10, tolerance 2 %: F against
+# Prandtl's (2 + pi) c / 200 kPa = 1.2854 must lie within issue 13's -3/+8 % (measured 1.2793,
+# -0.5 %; docs/VALIDATION.md, "Factor of safety by strength reduction"). About 18 s on two cores.
+add_test(NAME fos_v2_footing
+         COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/scripts/check_fos.py --binary $<TARGET_FILE:rktsph>
+                 --case ${PROJECT_SOURCE_DIR}/cases/examples/strip_footing_fos_2d.toml
+                 --out ${CMAKE_BINARY_DIR}/test-out/fos_v2_footing --scale 0.777968 --low 0.97 --high 1.08
+                 -- --solver v2 --set geometry.spacing=0.2 --tol 0.02 --jobs 2 --threads 2 --quiet)
+set_tests_properties(fos_v2_footing PROPERTIES LABELS validation PROCESSORS 2 TIMEOUT 600)
+
 # Every case file shipped under cases/ is sound: `rktsph check` reads it as `run` (or
 # `material-point`) would and builds its particles and solver, without running it. A key renamed
 # or a default changed without updating the files fails here, not in a user's run. Under a second.
