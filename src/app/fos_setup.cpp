@@ -238,7 +238,7 @@ Monitor resolve(const CaseDocument& doc, const FosTable& f) {
   m.window = f.window;
   m.kinetic_column = f.kinetic_of_stress_points ? "kinetic_stress_points" : "kinetic";
   m.spacing = setup.dx;
-  m.smoothing_length = setup.h_over_dx * setup.dx;
+  m.smoothing_length = setup.smoothing_length();
   if (!(f.window < setup.end_time)) {
     fail("window", fmt::format("the classification window ({} s) must be shorter than time.end ({} s)", f.window,
                                setup.end_time));

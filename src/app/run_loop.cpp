@@ -457,7 +457,7 @@ int run_loop(const LoopInput& in) {
         {"nodes", solver.nodes().size()},
         {"stress_points", solver.stress_points().size()},
         {"spacing", setup.dx},
-        {"smoothing_length", setup.h_over_dx * setup.dx},
+        {"smoothing_length", setup.smoothing_length()},
         {"max_wave_speed", solver.max_wave_speed()},
         {"dt", solver.dt()},
         {"dt_rule", adaptive ? "current" : "fixed"},

@@ -213,6 +213,8 @@ struct CaseSetup {
 
   // kernel
   double h_over_dx = 1.2;
+  /// The kernel's smoothing length h = h_over_dx * dx, m (method-notes §3.1).
+  double smoothing_length() const { return h_over_dx * dx; }
 
   // loads
   Vec<Dim> gravity = Vec<Dim>::Zero();  // m/s^2

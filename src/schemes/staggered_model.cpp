@@ -52,7 +52,7 @@ std::vector<std::string> stress_names() {
 
 template <int Dim>
 StaggeredModel<Dim>::StaggeredModel(CaseSetup<Dim> case_setup, exec::Threads threads)
-    : setup(std::move(case_setup)), policy(threads), kernel(setup.h_over_dx * setup.dx) {
+    : setup(std::move(case_setup)), policy(threads), kernel(setup.smoothing_length()) {
   // Size guards (case/size_limits.hpp) for cases built in code; the case reader has checked a
   // case file already, at the keys' lines. The lattice first, before it is generated.
   auto size_error = [this](const SizeProblem& p) {
