@@ -97,7 +97,7 @@ CaseReport validate_case11(const Options& opt, const std::string& dir) {
   for (double r : kMapRatios) maps.push_back(r * kB);
   std::ofstream meta(fs::path(dir) / "runs.csv");
   meta << "dx,file,maps,plateau,angle,emergence,width,start\n";
-  double width_prev = NAN;
+  double width_prev = NAN, dx_prev = NAN;
   for (double dx : spacings) {
     const FootingRun r =
         run_footing(file, {fmt::format("geometry.spacing={}", dx)}, t_end, 0.02, kB, std::sqrt(3.0) * kCohesion, maps, kCutY);
@@ -125,11 +125,10 @@ CaseReport validate_case11(const Options& opt, const std::string& dir) {
                          std::isfinite(err) ? err : 1.0, "<=", 0.08, "");
       if (!up.pass() && std::isfinite(err)) {
         up.known_deviation = fmt::format(
-            "open: mostly the soil's: the section cut 1.5 B deep gives {:+.1f} % over the same window (+16.0 % at "
-            "0.25 m, +11.1 % at 0.125 m in the full run); at 0.125 m the contact row's odd-even nodal-stress mode "
-            "adds to the reaction (docs/VALIDATION.md Case 12). The viscous overstress in the band is about 1 % at "
-            "this rate; the band (angle, emergence) is the exact mechanism's; the cause of the excess is not "
-            "established",
+            "open: the section cut 1.5 B deep gives {:+.1f} % over the same window. The excess is the simple "
+            "scheme's numerical viscosity in the band (method-notes eq. (2.3.2)): +12.6 / +15.2 % at 0.25 / "
+            "0.125 m with w = 1, +6.4 / +4.9 % with the case's w = 0.25 and nodal mean stress filter "
+            "(docs/VALIDATION.md Case 11)",
             100.0 * cut);
       }
       rep.metrics.push_back(up);
@@ -143,10 +142,21 @@ CaseReport validate_case11(const Options& opt, const std::string& dir) {
     rep.metrics.push_back(metric(tag + "band width (sqrt(12) x the cloud's spread across it)", band.width, "", 0.0,
                                  "m"));
     if (std::isfinite(width_prev)) {
-      rep.metrics.push_back(metric("band width: |w(fine) / w(coarse) - 1| (converges under refinement)",
-                                   std::abs(band.width / width_prev - 1.0), "<=", 0.25, ""));
+      Metric change = metric("band width: |w(fine) / w(coarse) - 1| (converges under refinement)",
+                             std::abs(band.width / width_prev - 1.0), "<=", 0.25, "");
+      // A band in a soil without softening: the exact one is a slip line of no width, and the
+      // less the velocity update smooths, the nearer its width comes to following dx.
+      if (!change.pass() && std::isfinite(change.value))
+        change.known_deviation = fmt::format(
+            "open: the band narrows from {:.2f} to {:.2f} m ({:.1f} to {:.1f} dx) when dx halves. Without softening "
+            "the exact band is a slip line of no width; the width that changed by 22 % with the simple scheme at full "
+            "weight was set by its numerical viscosity, which also held the plateau 13-15 % over 2c; with less of it "
+            "the width follows dx more closely (28 % at w = 0.25, 38 % at w = 0.1; docs/VALIDATION.md Case 11)",
+            width_prev, band.width, width_prev / dx_prev, band.width / dx);
+      rep.metrics.push_back(change);
     }
     width_prev = band.width;
+    dx_prev = dx;
     rep.notes.push_back(fmt::format("{}{} steps in {:.1f} s; {} nodes in the band{}", tag, r.steps, r.seconds,
                                     band.particles, r.stopped.empty() ? "" : "; stopped: " + r.stopped));
   }
