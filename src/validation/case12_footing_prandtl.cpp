@@ -133,7 +133,8 @@ CaseReport validate_case12(const Options& opt, const std::string& dir) {
               "open: the flowing zone reaches {:.3f} B, deeper than Prandtl's 0.71 B (plateau {:+.1f} % over (2 + pi) "
               "c). The simple scheme's numerical viscosity widens the mechanism (0.95-1.0 B at w = 1); at the case's "
               "w = 0.1 the smooth footing's zone is 0.81 / 0.88 B and the rough one's deepest flowing nodes are the "
-              "row at 0.9 B, moved 6-8 mm down (0.903 / 0.904 B at B/20 / B/40; docs/VALIDATION.md Case 12)",
+              "row at 0.9 B, moved 6-8 mm down (0.903 / 0.904 B at B/20 / B/40), a tail of the Perzyna viscosity's: at "
+              "gamma_f = 100 1/s instead of 10 it is 0.855 B (B/20; docs/VALIDATION.md Case 12)",
               m.zone_depth / kB, 100.0 * err);
         rep.metrics.push_back(z);
       }
