@@ -9,36 +9,23 @@ Usage: /usr/bin/python3 scripts/check_body_plateau.py --binary build/rktsph --ca
            --out DIR --body footing --width 1.0 --from 3.06 --reference 212.34e3 \
            --low 0.97 --high 1.08 [-- extra rktsph run arguments]
 """
-import argparse
 import csv
 import json
 import os
-import subprocess
 import sys
+
+from check_common import parser, run, split_extra
 
 
 def main():
-    argv = sys.argv[1:]
-    extra = []
-    if "--" in argv:
-        extra = argv[argv.index("--") + 1:]
-        argv = argv[: argv.index("--")]
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--binary", required=True)
-    p.add_argument("--case", required=True)
-    p.add_argument("--out", required=True)
+    argv, extra = split_extra()
+    p = parser(__doc__)
     p.add_argument("--body", required=True, help="the body's name in bodies.csv")
     p.add_argument("--width", type=float, required=True, help="m: the loaded width the force acts over")
     p.add_argument("--from", dest="t_from", type=float, required=True, help="s: the plateau's first record")
     p.add_argument("--reference", type=float, required=True, help="Pa: the exact limit pressure")
-    p.add_argument("--low", type=float, required=True)
-    p.add_argument("--high", type=float, required=True)
     a = p.parse_args(argv)
-    cmd = [a.binary, "run", a.case, "-o", a.out] + extra
-    print(" ".join(cmd), flush=True)
-    rc = subprocess.call(cmd)
-    if rc != 0:
-        sys.exit("rktsph run exited with status {}".format(rc))
+    run([a.binary, "run", a.case, "-o", a.out] + extra, "run")
     with open(os.path.join(a.out, "summary.json")) as f:
         summary = json.load(f)
     with open(os.path.join(a.out, "bodies.csv")) as f:

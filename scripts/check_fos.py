@@ -6,32 +6,19 @@ and scale * F lies in [low, high] (e.g. scale 3.4 turns F into gamma H / c_F for
 Usage: /usr/bin/python3 scripts/check_fos.py --binary build/rktsph --case CASE.toml --out DIR \
            --scale 3.4 --low 3.64 --high 4.00 [-- extra rktsph fos arguments]
 """
-import argparse
 import json
 import os
-import subprocess
 import sys
+
+from check_common import parser, run, split_extra
 
 
 def main():
-    argv = sys.argv[1:]
-    extra = []
-    if "--" in argv:
-        extra = argv[argv.index("--") + 1:]
-        argv = argv[: argv.index("--")]
-    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--binary", required=True)
-    p.add_argument("--case", required=True)
-    p.add_argument("--out", required=True)
+    argv, extra = split_extra()
+    p = parser(__doc__)
     p.add_argument("--scale", type=float, default=1.0)
-    p.add_argument("--low", type=float, required=True)
-    p.add_argument("--high", type=float, required=True)
     a = p.parse_args(argv)
-    cmd = [a.binary, "fos", a.case, "--out", a.out, "--no-plot"] + extra
-    print(" ".join(cmd), flush=True)
-    rc = subprocess.call(cmd)
-    if rc != 0:
-        sys.exit("rktsph fos exited with status {}".format(rc))
+    run([a.binary, "fos", a.case, "--out", a.out, "--no-plot"] + extra, "fos")
     with open(os.path.join(a.out, "fos.json")) as f:
         fos = json.load(f)
     lo, hi = fos["bracket"]
