@@ -192,7 +192,7 @@ void NodalConstraints<Dim>::resolve(const std::vector<BoundarySpec<Dim>>& specs,
         if ((reaction >> stress_slot<Dim>(k, d)) & 1u) {
           if (it != list.end()) list.erase(it);
         } else if (it == list.end()) {
-          list.push_back({comp, 0.0, -1});
+          list.push_back({comp, 0.0, -1, -1, true});
         }
       }
     }

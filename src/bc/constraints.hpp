@@ -24,6 +24,10 @@ struct NodalConstraint {
   double value = 0.0;
   int function = -1;
   int body = -1;
+  /// The traction-free default of a lattice face (a stress slot held at zero), not an entry's
+  /// own component: in V2 a rigid body pressing that face makes its normal stress a reaction
+  /// (StaggeredModel::released_by_contact).
+  bool face_default = false;
 };
 
 template <int Dim>

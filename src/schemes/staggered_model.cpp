@@ -266,6 +266,7 @@ void StaggeredModel<Dim>::apply_constraints(double t) {
   for (const Index i : constraints.constrained()) {
     for (Index k = constraints.begin(i); k < constraints.end(i); ++k) {
       const NodalConstraint& c = constraints[k];
+      if (released_by_contact(i, c)) continue;
       const double value = constraint_value(i, c, t);  // V3: sigma' = sigma + p_w
       if (c.component < Dim) {
         v(i, c.component) = value;

@@ -8,6 +8,7 @@
 // the half-step state at t^{n+1/2} (velocity, stress, history). The particles do not move in
 // these schemes, so the operators are built once, from relations that are then released.
 #include <array>
+#include <cmath>
 #include <functional>
 #include <memory>
 #include <vector>
@@ -117,6 +118,20 @@ class StaggeredModel {
   /// Body force per unit mass at time t, m/s^2.
   Vec<Dim> body_force(double t) const { return function_value(setup.gravity_function, t) * setup.gravity; }
 
+  /// Whether prescribed component c of node i is a lattice face's traction-free normal stress
+  /// on the face that a rigid body presses at this step (V2, method-notes §4.5): the contact
+  /// makes that stress a reaction, so it is not imposed (a node that a boundary entry selects,
+  /// as on a symmetry axis under a footing, keeps its faces' defaults otherwise).
+  bool released_by_contact(Index i, const NodalConstraint& c) const {
+    if (!c.face_default || contact.row.empty()) return false;
+    const Index r = contact.row[static_cast<std::size_t>(i)];
+    if (r < 0) return false;
+    const Vec<Dim>& n = contact.normal[static_cast<std::size_t>(r)];
+    for (int d = 0; d < Dim; ++d) {
+      if (c.component == Dim + stress_slot<Dim>(d, d) && std::abs(std::abs(n[d]) - 1.0) < 1e-9) return true;
+    }
+    return false;
+  }
   /// Value of a prescribed component at node i at time t. A prescribed normal stress is a
   /// TOTAL stress: with a pore pressure the effective stress held is sigma + p_w.
   double constraint_value(Index i, const NodalConstraint& c, double t) const {

@@ -455,6 +455,7 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
       const auto dr = static_cast<std::size_t>(drow);
       for (Index q = constraints.begin(i); q < constraints.end(i); ++q) {
         const NodalConstraint& con = constraints[q];
+        if (m_.released_by_contact(i, con)) continue;
         const double fhat = m_.constraint_value(i, con, t_half);
         const bool is_velocity = con.component < Dim;
         const int comp = is_velocity ? con.component : con.component - Dim;

@@ -13,12 +13,8 @@
 //      surface made traction-free again on the stress at t^{n+1}.
 // With rigid bodies (2D, method-notes §4.5): the contact set at t^n after step 0 (its nodes are
 // never flagged as free surface), the contact constraints, projections and reactions after 3.
-#include <fmt/format.h>
-
 #include <chrono>
-#include <cmath>
 #include <functional>
-#include <iostream>
 #include <memory>
 #include <string>
 #include <utility>
@@ -31,51 +27,6 @@
 #include "schemes/v2_stages.hpp"
 
 namespace rktsph {
-
-namespace {
-
-// A node that a [[boundary]] entry selects keeps the traction-free rule of its lattice faces
-// (method-notes §4.1), in V2 too: where such a node lies on a rigid body at the start, its normal
-// stress on the face the body presses stays zero and cancels the body's pressure there (the node
-// on the symmetry axis under a footing; docs/VALIDATION.md, "V2 with a rigid footing"). Thesis
-// Case 12 prescribes that node's velocity normal to the body as the body's, which makes the
-// stress a reaction; a force-driven body has no such velocity. Said once per body, with the
-// first such node.
-void warn_zero_stress_under_bodies(const StaggeredModel<2>& model) {
-  const double on_body = 1e-6 * model.dx();
-  for (const BodySpec& spec : model.setup.bodies) {
-    const RigidBody body(spec);
-    for (const Index i : model.constraints.constrained()) {
-      const Vec<2>& x = model.nodes.position[static_cast<std::size_t>(i)];
-      const BodyGap gap = body.gap(x, Vec<2>::Zero(), on_body);
-      if (!gap.within || std::abs(gap.g) > on_body) continue;
-      int axis = -1;  // the body's normal, when it is a lattice axis
-      for (int d = 0; d < 2; ++d) {
-        if (std::abs(std::abs(gap.normal[d]) - 1.0) < 1e-9) axis = d;
-      }
-      if (axis < 0) continue;
-      const int normal_stress = 2 + stress_slot<2>(axis, axis);
-      bool zero = false;
-      for (Index k = model.constraints.begin(i); k < model.constraints.end(i); ++k) {
-        const NodalConstraint& c = model.constraints[k];
-        zero = zero || (c.component == normal_stress && c.value == 0.0 && c.body < 0);
-      }
-      if (!zero) continue;
-      const char* name = axis == 0 ? "sigma_xx" : "sigma_yy";
-      std::cerr << fmt::format(
-          "warning: {}: the node at ({:g}, {:g}) lies on body '{}' and a [[boundary]] entry selects it, so it "
-          "keeps its lattice face's traction-free {} = 0, which cancels the body's pressure on it{}\n",
-          spec.where, x[0], x[1], spec.name, name,
-          spec.any_force() ? " (a force-driven body cannot make it a reaction; docs/VALIDATION.md, \"V2 with a rigid "
-                             "footing\")"
-                           : "; prescribe its velocity along the body's normal as the body's, as thesis Case 12 "
-                             "does for the node on its axis");
-      break;
-    }
-  }
-}
-
-}  // namespace
 
 template <int Dim>
 std::unique_ptr<Scheme> make_v2_scheme(StaggeredModel<Dim>& model) {
@@ -97,7 +48,6 @@ std::unique_ptr<Scheme> make_v2_scheme(StaggeredModel<Dim>& model) {
       contact = std::make_shared<RigidContact>(model.setup.bodies, model.nodes.position.size(),
                                                model.stress_points.position.size(), model.dx(),
                                                [&model](int f, double t) { return model.function_value(f, t); });
-      warn_zero_stress_under_bodies(model);
     }
   }
   ReseedStressPoints<Dim>* reseed = nullptr;

@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include <fmt/format.h>
@@ -197,6 +198,48 @@ TEST(RigidBodies, SmoothPlateCompressesABlockToTheOedometricSolution) {
   double flagged = 0.0;
   for (Index i = 0; i < sim.nodes().size(); ++i) flagged += sim.nodes().view(flags)(i, 0);
   EXPECT_EQ(flagged, 0.0);
+}
+
+// A node that a [[boundary]] entry selects keeps the traction-free rule of its lattice faces;
+// where a rigid body presses one of them the contact makes that face's normal stress a reaction
+// (StaggeredModel::released_by_contact, method-notes §4.5). The oedometer with its left wall a
+// symmetry entry (v_x = 0 on x = 0) instead of a body: the corner node (0, 1) under the plate is
+// selected by the entry, and must carry the plate's uniform sigma_yy like the nodes beside it
+// (before the release it held 0 there, as the node on the axis under a footing did).
+TEST(RigidBodies, ANodeAnEntrySelectsCarriesTheBodysPressure) {
+  const test::ThreadCount threads(1);
+  const double v0 = 1.0e-3 / 0.25;
+  CaseSetup<2> c = oedometer(
+      0.3,
+      [&](CaseBuilder<2>& b) {
+        TimeFunction f;
+        f.kind = TimeFunction::Kind::table;
+        f.times = {0.0, 0.05, 0.25, 0.30};
+        f.values = {0.0, 1.0, 1.0, 0.0};
+        b.function("push", f);
+        b.fix_velocity(Region<2>::plane(0, 0.0), {0});
+      },
+      [&](CaseSetup<2>& setup, BodySpec& top) {
+        top.velocity = {0.0, -v0};
+        top.velocity_function = {-1, function_named(setup, "push")};
+      });
+  c.bodies.erase(c.bodies.begin() + 1);  // the left wall: the entry holds that face instead
+  Simulation<2> sim(std::move(c));
+  while (sim.time() < 0.3 - 1e-12) sim.step();
+  const auto s = sim.node_stress();
+  const auto& x = sim.nodes().position;
+  auto syy_at = [&](double x0) {
+    std::size_t best = 0;
+    for (std::size_t i = 1; i < x.size(); ++i) {
+      if ((x[i] - Vec<2>(x0, 1.0)).norm() < (x[best] - Vec<2>(x0, 1.0)).norm()) best = i;
+    }
+    return s(best, StressComponent::yy);
+  };
+  const double corner = syy_at(0.0), middle = syy_at(0.5);
+  std::printf("sigma_yy under the plate at (0, 1) / (0.5, 1): %.1f / %.1f Pa (oedometric %.1f Pa)\n", corner, middle,
+              -kOedometric * 1.0e-3);
+  EXPECT_LT(middle, -0.8 * kOedometric * 1.0e-3);
+  EXPECT_NEAR(corner / middle, 1.0, 0.1);
 }
 
 TEST(RigidBodies, ForceDrivenPlateSettlesToTheExactSettlement) {

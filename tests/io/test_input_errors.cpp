@@ -687,48 +687,6 @@ TEST(InputErrors, SnapshotTimesPastTheEndWarn) {
   ASSERT_EQ(setup.warnings.size(), 1u);
 }
 
-// V2: a node that a boundary entry selects keeps its lattice face's traction-free rule; on a
-// rigid body that cancels the body's pressure there. The symmetry entry selects the node on the
-// axis under a footing: warned, naming the body's line; with that node's v_y prescribed (as
-// thesis Case 12 does) the stress is a reaction and nothing is said.
-TEST(InputErrors, ZeroStressUnderABodyWarns) {
-  test::TempDir dir;
-  const std::string footing = R"([[boundary]]
-name = "symmetry"
-x = [0.0, 0.0]
-velocity = { x = 0.0 }
-
-[[body]]
-name = "footing"
-segment = { a = [1.0, 1.0], b = [0.0, 1.0] }
-contact = "smooth"
-velocity = { x = 0.0, y = -0.01 }
-
-[solver]
-version = "v2"
-
-[time])";
-  const std::string text = replace(kBase, "[time]", footing);
-  const auto o = run_case_text(dir, text);
-  EXPECT_EQ(o.status, 0) << o.err;
-  EXPECT_NE(o.err.find(fmt::format("warning: {}, line {}, key 'body[0]'", o.file, line_of(text, "[[body]]"))),
-            std::string::npos)
-      << o.err;
-  EXPECT_NE(o.err.find("the node at (0, 1) lies on body 'footing'"), std::string::npos) << o.err;
-  EXPECT_NE(o.err.find("sigma_yy = 0"), std::string::npos) << o.err;
-  EXPECT_NE(o.err.find("prescribe its velocity"), std::string::npos) << o.err;
-  const std::string axis = replace(text, "[[body]]", R"([[boundary]]
-name = "axis under the footing"
-x = [0.0, 0.0]
-y = [1.0, 1.0]
-velocity = { x = 0.0, y = -0.01 }
-
-[[body]])");
-  const auto quiet = run_case_text(dir, axis);
-  EXPECT_EQ(quiet.status, 0) << quiet.err;
-  EXPECT_EQ(quiet.err.find("lies on body"), std::string::npos) << quiet.err;
-}
-
 TEST(InputErrors, NegativeSnapshotTime) {
   test::TempDir dir;
   const std::string text = replace(kBase, "[[probe]]", "[output]\ntimes = [0.0005, -1.0]\n\n[[probe]]");
