@@ -119,25 +119,31 @@ Means run_and_average(Simulation<2>& sim, double end, double from) {
   return m;
 }
 
-TEST(RigidBodies, SmoothPlateCompressesABlockToTheOedometricSolution) {
-  const test::ThreadCount threads(1);
-  // The plate's velocity rises linearly over 0.05 s (about the period 4H/c = 0.049 s of the
-  // first mode, which a ramp of one period leaves almost unexcited), is held, and falls again:
-  // 1 mm in all (strain 1e-3), then the plate rests.
+// The oedometer with its plate pushed 1 mm in all (strain 1e-3): the velocity rises linearly
+// over 0.05 s (about the period 4H/c = 0.049 s of the first mode, which a ramp of one period
+// leaves almost unexcited), is held, and falls again by 0.3 s; `more` adds to the case.
+CaseSetup<2> pushed_oedometer(double end, const std::function<void(CaseBuilder<2>&)>& more = {}) {
   const double v0 = 1.0e-3 / 0.25;
-  CaseSetup<2> c = oedometer(
-      0.5,
+  return oedometer(
+      end,
       [&](CaseBuilder<2>& b) {
         TimeFunction f;
         f.kind = TimeFunction::Kind::table;
         f.times = {0.0, 0.05, 0.25, 0.30};
         f.values = {0.0, 1.0, 1.0, 0.0};
         b.function("push", f);
+        if (more) more(b);
       },
       [&](CaseSetup<2>& setup, BodySpec& top) {
         top.velocity = {0.0, -v0};
         top.velocity_function = {-1, function_named(setup, "push")};
       });
+}
+
+TEST(RigidBodies, SmoothPlateCompressesABlockToTheOedometricSolution) {
+  const test::ThreadCount threads(1);
+  // The plate pushed 1 mm (pushed_oedometer), then at rest.
+  CaseSetup<2> c = pushed_oedometer(0.5);
   Simulation<2> sim(std::move(c));
   const Means mean = run_and_average(sim, 0.5, 0.35);
   const RigidContact& contact = contact_of(sim);
@@ -208,21 +214,7 @@ TEST(RigidBodies, SmoothPlateCompressesABlockToTheOedometricSolution) {
 // (before the release it held 0 there, as the node on the axis under a footing did).
 TEST(RigidBodies, ANodeAnEntrySelectsCarriesTheBodysPressure) {
   const test::ThreadCount threads(1);
-  const double v0 = 1.0e-3 / 0.25;
-  CaseSetup<2> c = oedometer(
-      0.3,
-      [&](CaseBuilder<2>& b) {
-        TimeFunction f;
-        f.kind = TimeFunction::Kind::table;
-        f.times = {0.0, 0.05, 0.25, 0.30};
-        f.values = {0.0, 1.0, 1.0, 0.0};
-        b.function("push", f);
-        b.fix_velocity(Region<2>::plane(0, 0.0), {0});
-      },
-      [&](CaseSetup<2>& setup, BodySpec& top) {
-        top.velocity = {0.0, -v0};
-        top.velocity_function = {-1, function_named(setup, "push")};
-      });
+  CaseSetup<2> c = pushed_oedometer(0.3, [](CaseBuilder<2>& b) { b.fix_velocity(Region<2>::plane(0, 0.0), {0}); });
   c.bodies.erase(c.bodies.begin() + 1);  // the left wall: the entry holds that face instead
   Simulation<2> sim(std::move(c));
   while (sim.time() < 0.3 - 1e-12) sim.step();
