@@ -24,24 +24,33 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// Files of an rktsph output folder that a new run replaces.
-bool is_run_output(const fs::path& dir) {
-  return fs::exists(dir / "summary.json") || fs::exists(dir / "case.resolved.toml");
+// A temporary file of an atomic write (io/output_files.hpp: NAME.tmpPID), left by a killed run.
+bool is_temporary(const std::string& name) {
+  const auto at = name.rfind(".tmp");
+  return at != std::string::npos && at + 4 < name.size() &&
+         name.find_first_not_of("0123456789", at + 4) == std::string::npos;
 }
 
-// Remove the temporary files of atomic writes that a killed run left (io/output_files.hpp:
-// NAME.tmpPID) in the output folder and its vtu/ and checkpoint/ folders.
+// Files of an rktsph output folder that a new run replaces. A run killed while it wrote its
+// first summary leaves only that summary's temporary file: still an rktsph folder.
+bool is_run_output(const fs::path& dir) {
+  if (fs::exists(dir / "summary.json") || fs::exists(dir / "case.resolved.toml")) return true;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    if (name.rfind("summary.json", 0) == 0 && is_temporary(name)) return true;
+  }
+  return false;
+}
+
+// Remove the temporary files of atomic writes that a killed run left in the output folder and
+// its vtu/ and checkpoint/ folders.
 void remove_temporaries(const fs::path& out) {
   std::error_code ec;
   for (const fs::path& dir : {out, out / "vtu", out / "checkpoint"}) {
     if (!fs::is_directory(dir, ec)) continue;
     for (const auto& e : fs::directory_iterator(dir, ec)) {
-      const std::string name = e.path().filename().string();
-      const auto at = name.rfind(".tmp");
-      if (at != std::string::npos && at + 4 < name.size() &&
-          name.find_first_not_of("0123456789", at + 4) == std::string::npos) {
-        fs::remove(e.path(), ec);
-      }
+      if (is_temporary(e.path().filename().string())) fs::remove(e.path(), ec);
     }
   }
 }
