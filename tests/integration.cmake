@@ -62,7 +62,7 @@ add_test(NAME v2_cphi_footing_plateau
 set_tests_properties(v2_cphi_footing_plateau PROPERTIES LABELS validation PROCESSORS 2 TIMEOUT 600)
 
 # The same soil in V2, the footing held under a force (fos.mode = "load", --solver v2, w = 0.1,
-# the stress points' kinetic energy) at B/10: F x 150 kPa / q_u must lie within 1.5 % of q_u of
+# the stress points' kinetic energy, fos.kinetic's "auto" for V2) at B/10: F x 150 kPa / q_u must lie within 1.5 % of q_u of
 # the 0.809 measured (docs/VALIDATION.md, "V2 with a rigid footing"). Before a contact node that
 # a boundary entry selects was released from its face's sigma_yy = 0, not even the nominal load
 # stood and the search stopped with an error. About 60 s on two cores.
@@ -71,7 +71,7 @@ add_test(NAME fos_v2_held_cphi20_b10
                  --case ${PROJECT_SOURCE_DIR}/cases/examples/strip_footing_cphi20_load_2d.toml
                  --out ${CMAKE_BINARY_DIR}/test-out/fos_v2_held_cphi20_b10 --scale 0.706409 --low 0.794 --high 0.824
                  -- --solver v2 --set geometry.spacing=0.2 --set solver.simple_weight=0.1
-                 --set fos.kinetic="stress_points" --jobs 2 --threads 1 --quiet)
+                 --jobs 2 --threads 1 --quiet)
 set_tests_properties(fos_v2_held_cphi20_b10 PROPERTIES LABELS validation PROCESSORS 2 TIMEOUT 600)
 
 # The static collapse load of the smooth rigid footing on c-phi soil (phi = 20 deg, fos.mode =

@@ -65,9 +65,10 @@ struct FosTable {
   std::optional<std::vector<double>> direction;      // unit vector of the monitored displacement
   std::optional<double> length;                      // m: H of a cut, B of a footing
   double window = 1.0;                               // s: the classification window
-  /// kinetic = "nodes" (default) | "stress_points": whose kinetic energy the classification
-  /// reads (energy.csv's `kinetic` or `kinetic_stress_points`).
-  bool kinetic_of_stress_points = false;
+  /// kinetic = "auto" (default) | "nodes" | "stress_points": whose kinetic energy the
+  /// classification reads (energy.csv's `kinetic` or `kinetic_stress_points`); "auto" reads the
+  /// stress points' for V2 trials and the nodes' otherwise (docs/fos.md, "Which kinetic energy").
+  std::optional<bool> kinetic_of_stress_points;
   SearchSettings search;
   std::string where;  // "case.toml, line N, key 'fos'" for messages
 };

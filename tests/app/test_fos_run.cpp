@@ -20,6 +20,7 @@
 #include "../support/test_util.hpp"
 #include "app/fos.hpp"
 #include "app/fos_setup.hpp"
+#include "case/case_reader.hpp"
 #include "core/error.hpp"
 
 namespace rktsph {
@@ -417,6 +418,26 @@ TEST(FosRun, LoadFactorOfATinyStripLoadBracketsPrandtl) {
   EXPECT_LT(end_sp, 1e-3 * peak_sp);
 }
 
+// fos.kinetic = "auto" (the default) reads the stress points' kinetic energy for a V2 trial,
+// whose nodes keep a kinetic energy above the stable rule's 1e-2 of its peak while the material
+// is at rest (docs/fos.md, "Which kinetic energy"), and the nodes' for V1; a key given wins.
+TEST(FosRun, KineticEnergyAutoReadsTheStressPointsOfV2Trials) {
+  test::TempDir dir;
+  std::string text = kStripLoad;
+  const std::string line = "kinetic = \"stress_points\"\n";
+  text.erase(text.find(line), line.size());
+  const std::string file = dir.write("strip.toml", text);
+  auto column = [&](const std::vector<std::string>& overrides) {
+    const CaseDocument doc = load_case_document(file, overrides);
+    return fos::resolve_monitor(doc, fos::read_fos_table(doc)).kinetic_column;
+  };
+  EXPECT_EQ(column({}), "kinetic");
+  EXPECT_EQ(column({"solver.version=\"v2\""}), "kinetic_stress_points");
+  EXPECT_EQ(column({"solver.version=\"v2\"", "fos.kinetic=\"nodes\""}), "kinetic");
+  EXPECT_EQ(column({"fos.kinetic=\"stress_points\""}), "kinetic_stress_points");
+  EXPECT_EQ(column({"fos.kinetic=\"auto\""}), "kinetic");
+}
+
 TEST(FosRun, LoadFactorInputErrors) {
   test::TempDir dir;
   using Edits = std::vector<std::pair<std::string, std::string>>;
@@ -446,7 +467,7 @@ TEST(FosRun, LoadFactorInputErrors) {
   expect_input_error("load_functions = [\"load\"]", "load_functions = [\"push\"]",
                      "no time function 'push' in the case (its functions: load)");
   expect_input_error("kinetic = \"stress_points\"", "kinetic = \"fluid\"",
-                     "unknown kinetic energy 'fluid': \"nodes\" or \"stress_points\"");
+                     "unknown kinetic energy 'fluid': \"auto\", \"nodes\" or \"stress_points\"");
   expect_input_error("mode = \"load\"", "mode = \"strength\"",
                      "the time functions of the loads are scaled only with mode = \"load\"");
   // A trial reaches the function through --set functions.NAME.scale, split at dots.
