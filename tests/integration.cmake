@@ -62,10 +62,11 @@ add_test(NAME v2_cphi_footing_plateau
 set_tests_properties(v2_cphi_footing_plateau PROPERTIES LABELS validation PROCESSORS 2 TIMEOUT 600)
 
 # The same soil in V2, the footing held under a force (fos.mode = "load", --solver v2, w = 0.1,
-# the stress points' kinetic energy, fos.kinetic's "auto" for V2) at B/10: F x 150 kPa / q_u must lie within 1.5 % of q_u of
-# the 0.809 measured (docs/VALIDATION.md, "V2 with a rigid footing"). Before a contact node that
-# a boundary entry selects was released from its face's sigma_yy = 0, not even the nominal load
-# stood and the search stopped with an error. About 60 s on two cores.
+# the stress points' kinetic energy: fos.kinetic's "auto" for V2) at B/10: F x 150 kPa / q_u
+# must lie within 1.5 % of q_u of the 0.809 measured (docs/VALIDATION.md, "V2 with a rigid
+# footing"). Before a contact node that a boundary entry selects was released from its face's
+# sigma_yy = 0, not even the nominal load stood and the search stopped with an error. About 90 s
+# on two cores.
 add_test(NAME fos_v2_held_cphi20_b10
          COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/scripts/check_fos.py --binary $<TARGET_FILE:rktsph>
                  --case ${PROJECT_SOURCE_DIR}/cases/examples/strip_footing_cphi20_load_2d.toml
