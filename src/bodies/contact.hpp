@@ -129,7 +129,7 @@ class RigidContact {
 
  private:
   void advance_bodies(double t, double dt, double damping);
-  void drive_bodies(double dt, const std::vector<Vec<2>>& x, ConstFieldView<double, 2> v, ConstFieldView<double, NS> s);
+  void drive_bodies(double dt, ConstFieldView<double, 2> v, ConstFieldView<double, NS> s);
   void select(const std::vector<Vec<2>>& x, ConstFieldView<double, 2> v, ConstFieldView<double, NS> s);
   void measure(const std::vector<Vec<2>>& x, ConstFieldView<double, 2> v, ConstFieldView<double, NS> s);
   /// along_ <- body b's contact slots within its extent, sorted by their position s along it.

@@ -377,6 +377,39 @@ TEST(Contact, OddEvenNodalStressNeitherBiasesNorReleasesAFooting) {
 }
 
 // Load control: a force-driven body accelerates by (F_applied + F_reaction) / M.
+// The reaction that drives a force-driven body is measured on the contact set's geometry of t^n,
+// as the contact set was chosen: a node stuck at the body's edge that step 2 carried a hair past
+// it stays in the sum. Before, the balance took the positions of step 2, dropped that node and
+// gave its length to its neighbour's end length (the mean traction of the last two nodes), while
+// the reaction reported after the step counted it: a rough footing held on the c-phi soil of
+// strip_footing_cphi20_load_2d.toml (V2, B/10), whose edge node had relaxed to sigma_yy ~ 0,
+// was balanced by 150 kN/m and reported 134.8, and the node's membership flipping with round-off
+// kicked the footing into a growing vibration (docs/VALIDATION.md, "V2 with a rigid footing").
+TEST(Contact, ABodysBalanceCountsTheNodesItsContactSetHolds) {
+  const double p = 1.0e5, dt = 1e-4;
+  BodySpec spec;
+  spec.name = "footing";
+  spec.shape = BodyShape::segment;
+  spec.points = {Vec<2>(0.3, 1.0), Vec<2>(0.0, 1.0)};  // the soil below
+  spec.law = ContactLaw::rough;
+  spec.force_driven = {false, true};
+  spec.force = {0.0, -p * 0.3};
+  spec.mass = 1.0e3;
+  RigidContact contact({spec}, 4, 0, kDx, unit_function);
+  Nodes n({Vec<2>(0.0, 1.0), Vec<2>(0.1, 1.0), Vec<2>(0.2, 1.0), Vec<2>(0.3, 1.0)});
+  for (std::size_t k = 0; k < 3; ++k) n.s[4 * k + 1] = -p;
+  n.s[4 * 3 + 1] = 0.0;  // the edge node, relaxed
+  n.begin(contact, 0.0, dt);
+  ASSERT_EQ(contact.in_contact()[3], 1);
+  n.x[3][0] += 1e-9;  // step 2 carries the edge node past the body's end
+  const double v0 = contact.state()[0].velocity[1];
+  n.end(contact, dt);
+  // The body's acceleration follows the reaction it reports (the edge node's half length at 0).
+  const double reported = contact.state()[0].force[1];
+  EXPECT_NEAR(reported, p * 0.25, 1e-6 * p);
+  EXPECT_NEAR((contact.state()[0].velocity[1] - v0) * spec.mass / dt, spec.force[1] + reported, 1e-6 * p);
+}
+
 TEST(Contact, ForceDrivenBodyFollowsItsForceBalance) {
   BodySpec spec = plane(Vec<2>(0.0, 1.0), Vec<2>(0.0, -1.0), ContactLaw::smooth);
   spec.force_driven = {false, true};
