@@ -19,6 +19,7 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "bodies/rigid_body.hpp"
@@ -72,6 +73,8 @@ class RigidContact {
   /// The join distance: a node at most this far from a body (as generated on it, or put back
   /// on it by a projection) may come into contact, m.
   double join_distance() const { return join_; }
+  /// The keep distance: a contact node stays in contact while at most this far from its body, m.
+  double keep_distance() const { return keep_; }
 
   /// State at t^n: the bodies' velocities over [t, t + dt] and the contact set.
   void begin_step(double t, double dt, double damping, const std::vector<Vec<2>>& x, ConstFieldView<double, 2> v,
@@ -116,6 +119,12 @@ class RigidContact {
   /// truncation of the support by: x off its surface (beyond the keep distance) but within
   /// `range` of it, and n_out pointing into it (within 45 degrees); -1 if none.
   int faces_body(const Vec<2>& x, const Vec<2>& n_out, double range) const;
+  /// The planes of body b's faces that x lies in front of, within `range` (RigidBody::planes_near
+  /// at the body's current position and the contact's depth): f(point, normal, distance).
+  template <class F>
+  void planes_near(std::size_t b, const Vec<2>& x, double range, F&& f) const {
+    bodies_[b].planes_near(x, state_[b].offset, depth_, range, std::forward<F>(f));
+  }
   /// Whether x lies behind the surface of a body where it is now (re-seeding leaves such cells
   /// empty).
   bool inside(const Vec<2>& x) const;

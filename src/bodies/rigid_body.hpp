@@ -66,6 +66,29 @@ class RigidBody {
   /// The gap of x with the body translated by `offset` from where the case puts it. Points more
   /// than `depth` behind a segment or polyline are not within it (a plane is a half space).
   BodyGap gap(const Vec<2>& x, const Vec<2>& offset, double depth) const;
+  /// The planes of the body's faces in front of which x lies (the segments whose extent holds
+  /// the projection of x, x at most `range` in front and `depth` behind; a plane body's own
+  /// plane), with the body translated by `offset`: calls f(point on the plane, unit normal into
+  /// the soil, signed distance of x) for each. What the free surface's mirror images reflect
+  /// across (method-notes §3.6, "Mirror images at rigid bodies").
+  template <class F>
+  void planes_near(const Vec<2>& x, const Vec<2>& offset, double depth, double range, F&& f) const {
+    if (spec_.shape == BodyShape::plane) {
+      const Vec<2> p = spec_.points[0] + offset;
+      const double g = (x - p).dot(spec_.normal);
+      if (g >= -depth && g <= range) f(p, spec_.normal, g);
+      return;
+    }
+    const double tol = 1e-9 * (s_end_ - s_begin_);
+    for (std::size_t k = 0; k < vertex_.size(); ++k) {
+      const Vec<2> p = vertex_[k] + offset;
+      const Vec<2> r = x - p;
+      const double s = r.dot(tangent_[k]);
+      if (s < -tol || s > length_[k] + tol) continue;
+      const double g = r.dot(normal_[k]);
+      if (g >= -depth && g <= range) f(p, normal_[k], g);
+    }
+  }
   /// The ends of the body along s (a plane has none: -inf, +inf).
   double s_begin() const { return s_begin_; }
   double s_end() const { return s_end_; }

@@ -385,6 +385,12 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
       s->require(c.detect_free_surface, "surface_refresh",
                  "applies to the detected free surface (solver.free_surface = \"detect\", V2 in 2D/3D)");
     }
+    c.surface_mirrors = s->boolean("surface_mirrors", false);
+    if (s->has("surface_mirrors")) {
+      s->require(c.detect_free_surface && Dim == 2, "surface_mirrors",
+                 "applies to the detected free surface beside rigid bodies (solver.free_surface = \"detect\", "
+                 "V2 in 2D)");
+    }
     const std::string reseed = s->string("reseed", "off");
     if (reseed == "off")
       c.reseed = ReseedSetting::off;

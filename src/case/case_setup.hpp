@@ -290,6 +290,10 @@ struct CaseSetup {
   /// some node has moved more than surface_refresh * dx (or changed its volume by more than 2 %)
   /// since the last full pass; 0: every step.
   double surface_refresh = 0.1;
+  /// The detection's mirror images at rigid bodies (method-notes §3.6, "Mirror images at rigid
+  /// bodies"; solver.surface_mirrors): a node beside a body that the soil reaches sums the
+  /// reflections of its neighbours across the body's face, for the detection only.
+  bool surface_mirrors = false;
   SourceCoupling coupling = SourceCoupling::additive;
   /// V2: the stress points re-seeded from the node cloud (method-notes §5.2, "Regularisation";
   /// solver.reseed): never, when the sets drift apart (eq. (5.2.4): more particles than after

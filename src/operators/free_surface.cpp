@@ -55,6 +55,13 @@ std::size_t gather_support(std::span<const Index> row, const Vec<Dim>& xi, const
   return count;
 }
 
+// The images of x across one plane, or across each of two and across both (the corner's).
+template <int Dim, class F>
+void for_each_image(std::span<const MirrorPlaneAt<Dim>* const> planes, const Vec<Dim>& x, F&& f) {
+  for (const auto* p : planes) f(reflect(*p, x));
+  if (planes.size() == 2) f(reflect(*planes[1], reflect(*planes[0], x)));
+}
+
 // The pairs of one node in arrays (structure of arrays), kept per thread between calls.
 template <int Dim>
 struct PairArrays {
@@ -67,6 +74,37 @@ struct PairArrays {
   void gather(std::span<const Index> row, const Vec<Dim>& xi, const ParticleSet<Dim>& set, double r2) {
     n = gather_support<Dim, double>(row, xi, set, r2, 0, x, d2, volume);
     if (factor.size() < d2.size()) factor.resize(d2.size());
+  }
+
+  // Step 7: the images, across `planes` (one, or two and the image across both), of the
+  // neighbours in front of every plane (a neighbour already behind one stands for the material
+  // there itself), those inside the support appended.
+  void append_images(std::span<const Index> row, const Vec<Dim>& xi, const ParticleSet<Dim>& set, double r2,
+                     std::span<const MirrorPlaneAt<Dim>* const> planes) {
+    const std::size_t images = planes.size() == 2 ? 3 : planes.size();
+    const std::size_t m = n + images * row.size();
+    if (d2.size() < m) {
+      for (auto& v : x) v.resize(m);
+      d2.resize(m);
+      volume.resize(m);
+      factor.resize(m);
+    }
+    for (const Index j : row) {
+      const auto ju = static_cast<std::size_t>(j);
+      const Vec<Dim>& xj = set.position[ju];
+      bool in_front = true;
+      for (const auto* p : planes) in_front = in_front && (xj - p->point).dot(p->normal) >= 0.0;
+      if (!in_front) continue;
+      for_each_image(planes, xj, [&](const Vec<Dim>& image) {
+        const Vec<Dim> x_ij = xi - image;
+        const double s = x_ij.squaredNorm();
+        if (s >= r2) return;
+        for (int d = 0; d < Dim; ++d) x[d][n] = x_ij[d];
+        d2[n] = s;
+        volume[n] = set.volume[ju];
+        ++n;
+      });
+    }
   }
 
   // B = sum_J V_J (x_J - x_I) (x) grad_I W_IJ (symmetric: grad_I W_IJ = W'/r x_IJ) and
@@ -163,7 +201,8 @@ void detect_free_surface(const ParticleSet<Dim>& set, const Relation<Dim>& relat
                          const CubicSplineKernel<Dim>& kernel, const FreeSurfaceOptions& options,
                          const std::vector<std::uint8_t>& previous, const std::vector<std::uint8_t>& excluded,
                          std::vector<std::uint8_t>& flags, std::vector<Vec<Dim>>& normals, const exec::Threads& policy,
-                         std::vector<std::uint8_t>* corners, FreeSurfaceScratch<Dim>* scratch) {
+                         std::vector<std::uint8_t>* corners, FreeSurfaceScratch<Dim>* scratch,
+                         const DetectionMirrors<Dim>* mirrors) {
   FreeSurfaceScratch<Dim> local;
   FreeSurfaceScratch<Dim>& work = scratch != nullptr ? *scratch : local;
   const Index n = set.size();
@@ -222,15 +261,28 @@ void detect_free_surface(const ParticleSet<Dim>& set, const Relation<Dim>& relat
     // the neighbours in the support gathered branch-free into arrays (a coincident particle,
     // d2 = 0, contributes nothing: its x_IJ is zero), then B and g summed in loops the compiler
     // vectorises (the square root and the kernel's piece 8 pairs at a time).
-    static thread_local ScreenArrays<Dim> screen;
-    const double screened = screen.lambda(relation.row(i), xi, set, r2, inv_h, alpha);
-    if (screened > options.interior_above + kScreenMargin) {
-      lambda[iu] = screened;  // only ever compared with the thresholds, which it clears
-      if (full) settled[iu] = screened > options.settled_above && (excluded.empty() || excluded[iu] == 0) ? 1 : 0;
-      return;
+    // A node with mirror images skips the screen (which sums the real neighbours only), so it
+    // is never settled either.
+    const MirrorPlaneAt<Dim>* plane_of[DetectionMirrors<Dim>::kPerNode] = {};
+    std::size_t planes = 0;
+    if (mirrors != nullptr && mirrors->has(iu)) {
+      for (const std::int32_t p : mirrors->of_node[iu]) {
+        if (p >= 0) plane_of[planes++] = &mirrors->planes[static_cast<std::size_t>(p)];
+      }
+    }
+    const std::span<const MirrorPlaneAt<Dim>* const> own_planes(plane_of, planes);
+    if (planes == 0) {
+      static thread_local ScreenArrays<Dim> screen;
+      const double screened = screen.lambda(relation.row(i), xi, set, r2, inv_h, alpha);
+      if (screened > options.interior_above + kScreenMargin) {
+        lambda[iu] = screened;  // only ever compared with the thresholds, which it clears
+        if (full) settled[iu] = screened > options.settled_above && (excluded.empty() || excluded[iu] == 0) ? 1 : 0;
+        return;
+      }
     }
     static thread_local PairArrays<Dim> pairs;
     pairs.gather(relation.row(i), xi, set, r2);
+    if (planes > 0) pairs.append_images(relation.row(i), xi, set, r2, own_planes);
     Mat<Dim> B;
     Vec<Dim> g;
     pairs.moments(inv_h, alpha, B, g);
@@ -247,28 +299,38 @@ void detect_free_surface(const ParticleSet<Dim>& set, const Relation<Dim>& relat
     } else if (lambda[iu] <= options.interior_above && len > 0.0) {
       // The umbrella scan: any neighbour in the region just outside I along n makes I interior.
       const Vec<Dim> T = xi + h * normal;
+      auto in_umbrella = [&](const Vec<Dim>& xj) {
+        const Vec<Dim> rel = xj - xi;
+        const double d2 = rel.squaredNorm();
+        if (d2 >= r2 || d2 == 0.0) return false;
+        const Vec<Dim> y = xj - T;
+        if (d2 >= near2) return y.squaredNorm() < h * h;
+        if constexpr (Dim == 2) {
+          const Vec<Dim> tangent(-normal[1], normal[0]);
+          return std::abs(normal.dot(y)) + std::abs(tangent.dot(y)) < h;
+        } else {
+          return rel.dot(normal) > std::cos(0.25 * std::numbers::pi) * std::sqrt(d2);  // the cone
+        }
+      };
       surface = true;
       for (const Index j : relation.row(i)) {
         // A particle without volume (deactivated outside a domain box) is no material.
         if (j == i || set.volume[static_cast<std::size_t>(j)] == 0.0) continue;
-        const Vec<Dim>& xj = set.position[static_cast<std::size_t>(j)];
-        const Vec<Dim> rel = xj - xi;
-        const double d2 = rel.squaredNorm();
-        if (d2 >= r2) continue;
-        const Vec<Dim> y = xj - T;
-        bool inside;
-        if (d2 >= near2) {
-          inside = y.squaredNorm() < h * h;
-        } else if constexpr (Dim == 2) {
-          const Vec<Dim> tangent(-normal[1], normal[0]);
-          inside = std::abs(normal.dot(y)) + std::abs(tangent.dot(y)) < h;
-        } else {
-          inside = rel.dot(normal) > std::cos(0.25 * std::numbers::pi) * std::sqrt(d2);  // the cone
-        }
-        if (inside) {
+        if (in_umbrella(set.position[static_cast<std::size_t>(j)])) {
           surface = false;
           break;
         }
+      }
+      // The images (step 7), of the node itself too: a plane just beyond the node fills the
+      // umbrella as the material behind it would.
+      for (std::size_t c = 0; surface && planes > 0 && c < relation.row(i).size(); ++c) {
+        const auto ju = static_cast<std::size_t>(relation.row(i)[c]);
+        if (set.volume[ju] == 0.0) continue;
+        const Vec<Dim>& xj = set.position[ju];
+        bool in_front = true;
+        for (const auto* p : own_planes) in_front = in_front && (xj - p->point).dot(p->normal) >= 0.0;
+        if (!in_front) continue;
+        for_each_image(own_planes, xj, [&](const Vec<Dim>& image) { surface = surface && !in_umbrella(image); });
       }
     }
     if (surface) {
@@ -403,12 +465,13 @@ void make_traction_free(const Vec<Dim>& n, double* s) {
   }
 }
 
-#define RKTSPH_INSTANTIATE(D)                                                                            \
-  template void detect_free_surface<D>(                                                                  \
-      const ParticleSet<D>&, const Relation<D>&, const CubicSplineKernel<D>&, const FreeSurfaceOptions&, \
-      const std::vector<std::uint8_t>&, const std::vector<std::uint8_t>&, std::vector<std::uint8_t>&,    \
-      std::vector<Vec<D>>&, const exec::Threads&, std::vector<std::uint8_t>*, FreeSurfaceScratch<D>*);   \
-  template void make_traction_free<D>(const Vec<D>&, double*);                                           \
+#define RKTSPH_INSTANTIATE(D)                                                                                  \
+  template void detect_free_surface<D>(const ParticleSet<D>&, const Relation<D>&, const CubicSplineKernel<D>&, \
+                                       const FreeSurfaceOptions&, const std::vector<std::uint8_t>&,            \
+                                       const std::vector<std::uint8_t>&, std::vector<std::uint8_t>&,           \
+                                       std::vector<Vec<D>>&, const exec::Threads&, std::vector<std::uint8_t>*, \
+                                       FreeSurfaceScratch<D>*, const DetectionMirrors<D>*);                    \
+  template void make_traction_free<D>(const Vec<D>&, double*);                                                 \
   template void make_corner_traction_free<D>(double*);
 RKTSPH_INSTANTIATE(1)
 RKTSPH_INSTANTIATE(2)

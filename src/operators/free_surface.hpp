@@ -11,7 +11,11 @@
 //      nodes (one on either side); a corner where those two differ by more than kCornerTurn;
 //   5. temporal coherence: a node that was not on the surface may become one only next to a
 //      node that was, or with lambda_I <= surface_below (a genuinely new surface);
-//   6. nodes excluded by the caller (explicit boundary conditions) are never flagged.
+//   6. nodes excluded by the caller (explicit boundary conditions) are never flagged;
+//   7. mirror images (optional): a node beside a rigid plane that the material reaches sums, in
+//      steps 1-3 only, the reflections of its neighbours across that plane as well, so that the
+//      plane does not cut its support (method-notes §3.6, "Mirror images at rigid bodies").
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -65,18 +69,47 @@ struct FreeSurfaceScratch {
   }
 };
 
+/// A rigid plane across which neighbours are reflected for the detection only (no field value
+/// is mirrored): a point on it and its unit normal, pointing into the material.
+template <int Dim>
+struct MirrorPlaneAt {
+  Vec<Dim> point = Vec<Dim>::Zero();
+  Vec<Dim> normal = Vec<Dim>::Zero();
+};
+
+/// The mirror planes of a detection: `planes`, and for each node the indices of at most two of
+/// them (-1: none). Empty `of_node`: no node has any.
+template <int Dim>
+struct DetectionMirrors {
+  static constexpr int kPerNode = 2;
+  std::vector<MirrorPlaneAt<Dim>> planes;
+  std::vector<std::array<std::int32_t, kPerNode>> of_node;
+  bool has(std::size_t i) const { return !of_node.empty() && of_node[i][0] >= 0; }
+  std::size_t bytes() const {
+    return planes.capacity() * sizeof(MirrorPlaneAt<Dim>) + of_node.capacity() * sizeof(of_node[0]);
+  }
+};
+
+/// The reflection of x across a plane.
+template <int Dim>
+Vec<Dim> reflect(const MirrorPlaneAt<Dim>& plane, const Vec<Dim>& x) {
+  return x - 2.0 * (x - plane.point).dot(plane.normal) * plane.normal;
+}
+
 /// Flags (1 = free surface) and outward unit normals of every particle of `set`, from
 /// `relation` (the set's own neighbours within the support; a wider Verlet list is cut back).
 /// `previous` (may be empty) holds the flags of the last step for the temporal coherence;
 /// `excluded` (may be empty) the particles never flagged. Normals are zero off the surface.
 /// `corners`, if given, gets 1 at the surface nodes where two faces meet (2D; see step 4).
+/// `mirrors`, if given, the planes whose images each node sums in steps 1-3 (step 7): a node
+/// with images is never settled (its images move with the bodies, not with the nodes).
 template <int Dim>
 void detect_free_surface(const ParticleSet<Dim>& set, const Relation<Dim>& relation,
                          const CubicSplineKernel<Dim>& kernel, const FreeSurfaceOptions& options,
                          const std::vector<std::uint8_t>& previous, const std::vector<std::uint8_t>& excluded,
                          std::vector<std::uint8_t>& flags, std::vector<Vec<Dim>>& normals,
                          const exec::Threads& policy = {}, std::vector<std::uint8_t>* corners = nullptr,
-                         FreeSurfaceScratch<Dim>* scratch = nullptr);
+                         FreeSurfaceScratch<Dim>* scratch = nullptr, const DetectionMirrors<Dim>* mirrors = nullptr);
 
 /// Traction-free stress by rotation to the local frame (method-notes §3.7): sigma.n = 0 with the
 /// tangential stress kept, sigma <- sigma - (sigma n) (x) n - n (x) (sigma n) + (n.sigma n) n (x) n;

@@ -288,8 +288,13 @@ void DetectFreeSurface<Dim>::run(const StepContext&) {
   });
   FreeSurfaceOptions options;
   options.refresh_displacement = m_.setup.surface_refresh * m_.dx();
+  const DetectionMirrors<Dim>* mirrors = nullptr;
+  if (contact_ != nullptr && m_.setup.surface_mirrors) {
+    build_mirrors();
+    mirrors = &mirrors_;
+  }
   detect_free_surface<Dim>(m_.nodes, rebuild_.node_neighbours(), m_.kernel, options, previous_, excluded_, flags_,
-                           normals_, m_.policy, &corners_, &scratch_);
+                           normals_, m_.policy, &corners_, &scratch_, mirrors);
   unflagged_by_bodies_ = 0;
   if constexpr (Dim == 2) {
     // Next to a body the support is cut by it, not by a free surface: a flag whose normal
@@ -342,6 +347,71 @@ void DetectFreeSurface<Dim>::run(const StepContext&) {
                                       m_.kernel, rows.gradient);
   reapply_traction_free();
   seconds_ += since(t0);
+}
+
+template <int Dim>
+void DetectFreeSurface<Dim>::build_mirrors() {
+  // A node not excluded, in front of a face of a body within the support radius, mirrors across
+  // that face when the soil reaches the body near it: a neighbour within the support in contact
+  // with that body (a face looking at a body across a gap has none, and keeps its own support).
+  // Coincident faces (a node above the joint of two collinear segments) count once; at most the
+  // two nearest faces (a concave corner).
+  mirrored_nodes_ = 0;
+  mirrors_.planes.clear();
+  const auto nn = static_cast<std::size_t>(m_.nodes.size());
+  mirrors_.of_node.assign(nn, {-1, -1});
+  if constexpr (Dim == 2) {
+    const double range = m_.kernel.support_radius();
+    const auto& neighbours = rebuild_.node_neighbours();
+    const std::size_t bodies = contact_->bodies().size();
+    const double keep = contact_->keep_distance();
+    struct Face {
+      MirrorPlaneAt<Dim> plane;
+      double g;
+    };
+    constexpr int kMaxFaces = 4;
+    for (std::size_t i = 0; i < nn; ++i) {
+      if (excluded_[i] != 0) continue;
+      const Vec<Dim>& xi = m_.nodes.position[i];
+      std::array<Face, kMaxFaces> faces;
+      int count = 0;
+      for (std::size_t b = 0; b < bodies; ++b) {
+        int from = count;
+        contact_->planes_near(b, xi, range, [&](const Vec<2>& p, const Vec<2>& n, double g) {
+          if (count < kMaxFaces && g > keep) faces[static_cast<std::size_t>(count++)] = {{p, n}, g};
+        });
+        if (count == from) continue;
+        bool reached = false;
+        for (const Index j : neighbours.row(static_cast<Index>(i))) {
+          const auto ju = static_cast<std::size_t>(j);
+          if (reached) break;
+          if ((m_.nodes.position[ju] - xi).squaredNorm() >= range * range) continue;
+          for (int k = 0; k < RigidContact::kMaxContacts; ++k)
+            reached = reached || contact_->contact_body(ju, k) == static_cast<int>(b);
+        }
+        if (!reached) count = from;
+      }
+      if (count == 0) continue;
+      for (int f = 1; f < count; ++f) {  // nearest first (a handful: by insertion)
+        for (int e = f; e > 0 && faces[static_cast<std::size_t>(e)].g < faces[static_cast<std::size_t>(e - 1)].g; --e)
+          std::swap(faces[static_cast<std::size_t>(e)], faces[static_cast<std::size_t>(e - 1)]);
+      }
+      int kept = 0;
+      for (int f = 0; f < count && kept < DetectionMirrors<Dim>::kPerNode; ++f) {
+        const MirrorPlaneAt<Dim>& plane = faces[static_cast<std::size_t>(f)].plane;
+        bool same = false;
+        for (int k = 0; k < kept; ++k) {
+          const MirrorPlaneAt<Dim>& other = mirrors_.planes[static_cast<std::size_t>(mirrors_.of_node[i][k])];
+          same = same || (plane.normal.dot(other.normal) > 1.0 - 1e-9 &&
+                          std::abs((plane.point - other.point).dot(other.normal)) < 1e-9 * range);
+        }
+        if (same) continue;
+        mirrors_.of_node[i][static_cast<std::size_t>(kept++)] = static_cast<std::int32_t>(mirrors_.planes.size());
+        mirrors_.planes.push_back(plane);
+      }
+      ++mirrored_nodes_;
+    }
+  }
 }
 
 template <int Dim>

@@ -130,7 +130,7 @@ class DetectFreeSurface final : public Stage {
   void run(const StepContext& context) override;
   std::size_t scratch_bytes() const override {
     return previous_.capacity() + flags_.capacity() + excluded_.capacity() + corners_.capacity() +
-           normals_.capacity() * sizeof(Vec<Dim>) + scratch_.bytes();
+           normals_.capacity() * sizeof(Vec<Dim>) + scratch_.bytes() + mirrors_.bytes();
   }
   void save(io::StateArchive& archive, const std::string& prefix) const override;
   void load(const io::StateArchive& archive, const std::string& prefix) override;
@@ -147,7 +147,8 @@ class DetectFreeSurface final : public Stage {
             {"detection_seconds", seconds_},
             {"detection_full_passes", static_cast<double>(scratch_.full_passes)},
             {"detection_partial_passes", static_cast<double>(scratch_.partial_passes)},
-            {"unflagged_next_to_bodies_last_step", static_cast<double>(unflagged_by_bodies_)}};
+            {"unflagged_next_to_bodies_last_step", static_cast<double>(unflagged_by_bodies_)},
+            {"mirrored_nodes_last_step", static_cast<double>(mirrored_nodes_)}};
   }
 
  private:
@@ -158,6 +159,10 @@ class DetectFreeSurface final : public Stage {
   std::vector<std::uint8_t> previous_, flags_, excluded_, fixed_excluded_, corners_;
   const RigidContact* contact_ = nullptr;
   Index unflagged_by_bodies_ = 0;
+  /// The mirror planes of the last detection (solver.surface_mirrors) and how many nodes had any.
+  void build_mirrors();
+  DetectionMirrors<Dim> mirrors_;
+  Index mirrored_nodes_ = 0;
   FreeSurfaceScratch<Dim> scratch_;
   std::vector<Vec<Dim>> normals_;
   std::vector<Index> surface_;  // the flagged nodes

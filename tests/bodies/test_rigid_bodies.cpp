@@ -662,6 +662,42 @@ TEST(RigidBodies, FreeCornersWhereTheSoilEndsOnABody) {
   }
 }
 
+// solver.surface_mirrors (method-notes §3.6 item 6): a block at rest on a rough base, its bottom
+// row in contact. Mirrored are the nodes farther from the base than the keep distance (dx/2) and
+// within the support 2h = 0.24 m, beside a contact node: the rows y = 0.1 and 0.2, 22 nodes.
+// Flagged are the sides above the base and the top, exactly, with the sides' normals down to
+// the base; without the option the same (the rule of §4.5 finds nothing to remove here).
+TEST(RigidBodies, MirrorImagesAtTheBaseLeaveTheSidesAndTopFlagged) {
+  for (const bool mirrors : {false, true}) {
+    CaseBuilder<2> b("block on a base");
+    b.spacing(0.1).block(Vec<2>(0.0, 0.0), Vec<2>(1.0, 1.0)).elastic(kE, kNu, kRho).scheme("v2").free_surface(true);
+    b.time(0.01, 0.5);
+    CaseSetup<2> c = b.build();
+    c.surface_mirrors = mirrors;
+    c.bodies.push_back(plane_body("base", Vec<2>(0.0, 0.0), Vec<2>(0.0, 1.0), ContactLaw::rough));
+    Simulation<2> sim(std::move(c));
+    for (int k = 0; k < 3; ++k) sim.step();
+    const auto* detect = sim.scheme().find<DetectFreeSurface<2>>();
+    ASSERT_NE(detect, nullptr);
+    double mirrored = -1.0;
+    for (const auto& [key, value] : detect->report()) {
+      if (key == "mirrored_nodes_last_step") mirrored = value;
+    }
+    EXPECT_EQ(mirrored, mirrors ? 22.0 : 0.0);
+    const auto flags = sim.nodes().view(sim.nodes().template find<double, 1>("free_surface"));
+    const auto normals = sim.nodes().view(sim.nodes().template find<double, 2>("normal"));
+    const auto& x = sim.nodes().position;
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      const bool side = (x[i][0] < 1e-6 || x[i][0] > 1.0 - 1e-6) && x[i][1] > 0.05, top = x[i][1] > 1.0 - 1e-6;
+      EXPECT_EQ(flags(i, 0) != 0.0, side || top) << "node at " << x[i].transpose() << ", mirrors " << mirrors;
+      if (side && !top) {
+        EXPECT_NEAR(normals(i, 0), x[i][0] < 0.5 ? -1.0 : 1.0, 1e-9) << x[i].transpose();
+        EXPECT_NEAR(normals(i, 1), 0.0, 1e-9) << x[i].transpose();
+      }
+    }
+  }
+}
+
 }  // namespace
 }  // namespace rktsph
 

@@ -277,6 +277,14 @@ TEST(InputErrors, SurfaceRefreshOutOfRangeOrWithoutDetection) {
   expect_error_at(run_case_text(dir, faces), line_of(faces, "surface_refresh"), "solver.surface_refresh", {"detect"});
 }
 
+TEST(InputErrors, SurfaceMirrorsNeedTheDetectedSurface) {
+  test::TempDir dir;
+  const std::string v1 = replace(kBase, "[time]", "[solver]\nsurface_mirrors = true\n[time]");
+  expect_error_at(run_case_text(dir, v1), line_of(v1, "surface_mirrors"), "solver.surface_mirrors", {"detect"});
+  const std::string word = replace(kBase, "[time]", "[solver]\nversion = \"v2\"\nsurface_mirrors = \"yes\"\n[time]");
+  expect_error_at(run_case_text(dir, word), line_of(word, "surface_mirrors"), "solver.surface_mirrors", {});
+}
+
 TEST(InputErrors, DomainBoxNeedsBothCorners) {
   test::TempDir dir;
   const std::string text = replace(kBase, "[time]", "[solver]\nversion = \"v2\"\ndomain_min = [-1.0, -1.0]\n[time]");

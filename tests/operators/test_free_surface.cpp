@@ -162,6 +162,84 @@ TEST(FreeSurface, TheSettledInteriorIsSkippedUntilANodeMovesOrSwells) {
   EXPECT_TRUE(detect());
 }
 
+// Mirror images at rigid planes (step 7, method-notes §3.6): the block x in [-1, 1], y in [0, 1]
+// resting on planes just beyond its faces, its nodes there not excluded (none in contact), so
+// that only the images keep the plane from reading as a free surface.
+DetectionMirrors<2> mirrors_within(const Cloud& c, double range, const std::vector<MirrorPlaneAt<2>>& planes) {
+  DetectionMirrors<2> m;
+  m.planes = planes;
+  m.of_node.assign(static_cast<std::size_t>(c.set.size()), {-1, -1});
+  for (std::size_t i = 0; i < m.of_node.size(); ++i) {
+    int k = 0;
+    for (std::size_t p = 0; p < planes.size(); ++p) {
+      const double g = (c.set.position[i] - planes[p].point).dot(planes[p].normal);
+      if (g >= 0.0 && g <= range) m.of_node[i][static_cast<std::size_t>(k++)] = static_cast<std::int32_t>(p);
+    }
+  }
+  return m;
+}
+
+struct Detection {
+  std::vector<std::uint8_t> flags, corners;
+  std::vector<Vec<2>> normals;
+};
+
+Detection detect_block(const Cloud& c, double dx, const DetectionMirrors<2>* mirrors) {
+  const CubicSplineKernel<2> kernel(1.2 * dx);
+  Relation<2> rel;
+  rel.build(c.set.position, c.set.position, {kernel.support_radius(), 1, true});
+  Detection d;
+  detect_free_surface<2>(c.set, rel, kernel, {}, {}, {}, d.flags, d.normals, exec::Threads{}, &d.corners, nullptr,
+                         mirrors);
+  return d;
+}
+
+TEST(FreeSurface, MirrorImagesAcrossARigidPlaneLeaveItsNeighboursUnflagged) {
+  const double dx = 0.1, h = 1.2 * dx;
+  const Cloud c = lattice_cloud(dx, 10, [](const Vec<2>& x) { return x[1] >= -1e-9; });
+  // The base 0.3 dx below the bottom row (a row hovering within the contact's keep distance).
+  const std::vector<MirrorPlaneAt<2>> base{{Vec<2>(0.0, -0.3 * dx), Vec<2>(0.0, 1.0)}};
+  const Detection plain = detect_block(c, dx, nullptr);
+  const DetectionMirrors<2> m = mirrors_within(c, 2.0 * h, base);
+  const Detection mirrored = detect_block(c, dx, &m);
+  long bottom_plain = 0;
+  for (Index i = 0; i < c.set.size(); ++i) {
+    const auto iu = static_cast<std::size_t>(i);
+    const Vec<2>& x = c.set.position[iu];
+    const bool side = std::abs(std::abs(x[0]) - 1.0) < 1e-9, top = std::abs(x[1] - 1.0) < 1e-9;
+    if (x[1] < 1e-9 && !side) bottom_plain += plain.flags[iu];
+    EXPECT_EQ(mirrored.flags[iu] != 0, side || top) << "node at " << x.transpose();
+    // The sides run on into their images: every side node below the top is a face node with the
+    // side's normal, the bottom one included; the top corners are the only corners.
+    EXPECT_EQ(mirrored.corners[iu] != 0, side && top) << "node at " << x.transpose();
+    if (side && !top) {
+      EXPECT_NEAR((mirrored.normals[iu] - Vec<2>(x[0] > 0 ? 1.0 : -1.0, 0.0)).norm(), 0.0, 1e-12) << x.transpose();
+    }
+  }
+  EXPECT_EQ(bottom_plain, 19) << "without the images the plane reads as a free surface";
+  EXPECT_EQ(count(mirrored.flags), 21 + 2 * 10);
+}
+
+TEST(FreeSurface, MirrorImagesInAConcaveCornerLeaveBothWallsUnflagged) {
+  // The block in the corner of a base and a wall on its left, each 0.3 dx beyond it: flagged are
+  // the right side and the top only, the node nearest the corner (two planes and the image
+  // across both) included among the unflagged.
+  const double dx = 0.1, h = 1.2 * dx;
+  const Cloud c = lattice_cloud(dx, 10, [](const Vec<2>& x) { return x[1] >= -1e-9; });
+  const std::vector<MirrorPlaneAt<2>> walls{{Vec<2>(0.0, -0.3 * dx), Vec<2>(0.0, 1.0)},
+                                            {Vec<2>(-1.0 - 0.3 * dx, 0.0), Vec<2>(1.0, 0.0)}};
+  const DetectionMirrors<2> m = mirrors_within(c, 2.0 * h, walls);
+  const Detection d = detect_block(c, dx, &m);
+  for (Index i = 0; i < c.set.size(); ++i) {
+    const auto iu = static_cast<std::size_t>(i);
+    const Vec<2>& x = c.set.position[iu];
+    const bool right = std::abs(x[0] - 1.0) < 1e-9, top = std::abs(x[1] - 1.0) < 1e-9;
+    EXPECT_EQ(d.flags[iu] != 0, right || top) << "node at " << x.transpose();
+    EXPECT_EQ(d.corners[iu] != 0, right && top) << "node at " << x.transpose();
+  }
+  EXPECT_EQ(count(d.flags), 21 + 10);
+}
+
 TEST(FreeSurface, TheTractionFreeRotationZeroesSigmaNAndKeepsTheTangentialStress) {
   const double a = 0.6;
   const Vec<2> n(std::cos(a), std::sin(a)), t(-std::sin(a), std::cos(a));
