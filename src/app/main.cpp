@@ -171,6 +171,11 @@ int main(int argc, char** argv) {
   val_cmd->add_option("cases", val.only, "Case numbers to run, e.g. 01, or mandel (default: all)");
   auto* full_flag = val_cmd->add_flag("--full", val.full, "docs/cases.md acceptance resolutions");
   val_cmd->add_flag("--quick", val_quick, "Coarse resolutions that fit in CI (default)")->excludes(full_flag);
+  val_cmd
+      ->add_flag("--refine", val.refine,
+                 "With --full: one more halving of the finest spacing where a criterion is a convergence under "
+                 "refinement (Case 11's band width: 0.0625 m, about 25 min on two threads)")
+      ->needs(full_flag);
   val_cmd->add_option("--out,-o", val.out_dir, "Report folder (default: validation)");
   val_cmd->add_option("--cases-dir", val.cases_dir, "Folder of the thesis case files");
   val_cmd->add_flag("!--no-plots", val.plots, "Skip the matplotlib plots");

@@ -65,6 +65,9 @@ struct Options {
   std::string cases_dir;          // where cases/thesis lives
   std::vector<std::string> only;  // case ids; empty = all
   bool plots = true;
+  /// With full: one more halving of the finest spacing in the cases whose criterion is a
+  /// convergence under refinement (Case 11's band width), reported beside the criterion.
+  bool refine = false;
 };
 
 /// Run one validation case; writes CSV data and plots under out_dir/case<id>/.
