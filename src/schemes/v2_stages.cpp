@@ -351,9 +351,12 @@ void DetectFreeSurface<Dim>::run(const StepContext&) {
 
 template <int Dim>
 void DetectFreeSurface<Dim>::build_mirrors() {
-  // A node not excluded, in front of a face of a body within the support radius, mirrors across
-  // that face when the soil reaches the body near it: a neighbour within the support in contact
-  // with that body (a face looking at a body across a gap has none, and keeps its own support).
+  // A node not excluded, in front of a face of a body farther than the contact's keep distance
+  // and within the support radius, mirrors across that face when the soil reaches the body near
+  // it: a neighbour within the support in contact with that body (a face looking at a body across
+  // a gap has none, and keeps its own support). Within the keep distance a node not in contact
+  // is taken for one released from the body, whose flag is a true free surface (method-notes
+  // §4.5, "Free surface"); images there made thesis Case 10 unstable (docs/VALIDATION.md).
   // Coincident faces (a node above the joint of two collinear segments) count once; at most the
   // two nearest faces (a concave corner).
   mirrored_nodes_ = 0;
@@ -376,7 +379,7 @@ void DetectFreeSurface<Dim>::build_mirrors() {
       std::array<Face, kMaxFaces> faces;
       int count = 0;
       for (std::size_t b = 0; b < bodies; ++b) {
-        int from = count;
+        const int from = count;
         contact_->planes_near(b, xi, range, [&](const Vec<2>& p, const Vec<2>& n, double g) {
           if (count < kMaxFaces && g > keep) faces[static_cast<std::size_t>(count++)] = {{p, n}, g};
         });

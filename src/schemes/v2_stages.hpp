@@ -138,7 +138,8 @@ class DetectFreeSurface final : public Stage {
   /// sigma.n = 0 at the flagged nodes with the normals of the last detection.
   void reapply_traction_free();
   /// Rigid bodies (2D): their contact nodes are never flagged, and a node whose flag only
-  /// reflects the support cut by a body (its normal pointing into the body) is unflagged.
+  /// reflects the support cut by a body (its normal pointing into the body) is unflagged; with
+  /// solver.surface_mirrors the nodes beside a body first sum their neighbours' mirror images.
   void set_contact(const RigidContact* contact) { contact_ = contact; }
   /// 1 at the flagged nodes where two faces meet, from the last detection (empty before it).
   const std::vector<std::uint8_t>& corners() const { return corners_; }
