@@ -158,7 +158,7 @@ class RigidContact {
   std::vector<std::int8_t> slip_, previous_slip_;
   std::vector<std::uint8_t> in_contact_;
   std::vector<double> release_snn_;  // per slot of the last step: the normal stress that decides a release
-  std::vector<Vec<2>> x_begin_;      // positions at t^n (contact nodes only are read)
+  std::vector<Vec<2>> x_begin_;      // positions at t^n (the force-driven balance measures on them)
   std::vector<std::pair<double, std::size_t>> along_;  // (s, node) of one body's contact nodes
   std::vector<ContactPoint> profile_;                  // every body's contact nodes, last measure
   struct PatchEnd {

@@ -44,22 +44,15 @@ BodyGap RigidBody::gap(const Vec<2>& x, const Vec<2>& offset, double depth) cons
   // The segment whose extent holds the projection of x and that is nearest (a concave corner
   // has two; the one nearer decides). A point past a convex corner, in the wedge that no
   // segment's extent covers, is within no segment: it cannot be touching the body there.
-  const double tol = 1e-9 * (s_end_ - s_begin_);
   double best = std::numeric_limits<double>::infinity();
-  for (std::size_t k = 0; k < vertex_.size(); ++k) {
-    const Vec<2> r = x - (vertex_[k] + offset);
-    const double s = r.dot(tangent_[k]);
-    if (s < -tol || s > length_[k] + tol) continue;
-    const double g = r.dot(normal_[k]);
-    if (g < -depth) continue;
-    if (std::abs(g) < best) {
-      best = std::abs(g);
-      out.g = g;
-      out.normal = normal_[k];
-      out.s = arc_[k] + s;
-      out.within = true;
-    }
-  }
+  segments_holding(x, offset, depth, [&](std::size_t k, double s, double g) {
+    if (std::abs(g) >= best) return;
+    best = std::abs(g);
+    out.g = g;
+    out.normal = normal_[k];
+    out.s = arc_[k] + s;
+    out.within = true;
+  });
   return out;
 }
 

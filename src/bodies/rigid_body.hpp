@@ -79,21 +79,30 @@ class RigidBody {
       if (g >= -depth && g <= range) f(p, spec_.normal, g);
       return;
     }
-    const double tol = 1e-9 * (s_end_ - s_begin_);
-    for (std::size_t k = 0; k < vertex_.size(); ++k) {
-      const Vec<2> p = vertex_[k] + offset;
-      const Vec<2> r = x - p;
-      const double s = r.dot(tangent_[k]);
-      if (s < -tol || s > length_[k] + tol) continue;
-      const double g = r.dot(normal_[k]);
-      if (g >= -depth && g <= range) f(p, normal_[k], g);
-    }
+    segments_holding(x, offset, depth, [&](std::size_t k, double, double g) {
+      if (g <= range) f(Vec<2>(vertex_[k] + offset), normal_[k], g);
+    });
   }
   /// The ends of the body along s (a plane has none: -inf, +inf).
   double s_begin() const { return s_begin_; }
   double s_end() const { return s_end_; }
 
  private:
+  /// The segments whose extent holds the projection of x (to 1e-9 of the body's length) with x
+  /// at most `depth` behind them: f(segment k, s along it, signed distance g). A point past a
+  /// convex corner, in the wedge no segment's extent covers, is held by none.
+  template <class F>
+  void segments_holding(const Vec<2>& x, const Vec<2>& offset, double depth, F&& f) const {
+    const double tol = 1e-9 * (s_end_ - s_begin_);
+    for (std::size_t k = 0; k < vertex_.size(); ++k) {
+      const Vec<2> r = x - (vertex_[k] + offset);
+      const double s = r.dot(tangent_[k]);
+      if (s < -tol || s > length_[k] + tol) continue;
+      const double g = r.dot(normal_[k]);
+      if (g >= -depth) f(k, s, g);
+    }
+  }
+
   BodySpec spec_;
   std::vector<Vec<2>> vertex_, tangent_, normal_;
   std::vector<double> length_, arc_;  // per segment: its length and the arc length at its start

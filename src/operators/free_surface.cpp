@@ -55,6 +55,16 @@ std::size_t gather_support(std::span<const Index> row, const Vec<Dim>& xi, const
   return count;
 }
 
+// Whether x lies in front of every plane (a point behind one stands for the material there itself
+// and is not reflected).
+template <int Dim>
+bool in_front_of(std::span<const MirrorPlaneAt<Dim>* const> planes, const Vec<Dim>& x) {
+  for (const auto* p : planes) {
+    if ((x - p->point).dot(p->normal) < 0.0) return false;
+  }
+  return true;
+}
+
 // The images of x across one plane, or across each of two and across both (the corner's).
 template <int Dim, class F>
 void for_each_image(std::span<const MirrorPlaneAt<Dim>* const> planes, const Vec<Dim>& x, F&& f) {
@@ -92,9 +102,7 @@ struct PairArrays {
     for (const Index j : row) {
       const auto ju = static_cast<std::size_t>(j);
       const Vec<Dim>& xj = set.position[ju];
-      bool in_front = true;
-      for (const auto* p : planes) in_front = in_front && (xj - p->point).dot(p->normal) >= 0.0;
-      if (!in_front) continue;
+      if (!in_front_of(planes, xj)) continue;
       for_each_image(planes, xj, [&](const Vec<Dim>& image) {
         const Vec<Dim> x_ij = xi - image;
         const double s = x_ij.squaredNorm();
@@ -327,9 +335,7 @@ void detect_free_surface(const ParticleSet<Dim>& set, const Relation<Dim>& relat
         const auto ju = static_cast<std::size_t>(relation.row(i)[c]);
         if (set.volume[ju] == 0.0) continue;
         const Vec<Dim>& xj = set.position[ju];
-        bool in_front = true;
-        for (const auto* p : own_planes) in_front = in_front && (xj - p->point).dot(p->normal) >= 0.0;
-        if (!in_front) continue;
+        if (!in_front_of(own_planes, xj)) continue;
         for_each_image(own_planes, xj, [&](const Vec<Dim>& image) { surface = surface && !in_umbrella(image); });
       }
     }

@@ -376,7 +376,6 @@ TEST(Contact, OddEvenNodalStressNeitherBiasesNorReleasesAFooting) {
   }
 }
 
-// Load control: a force-driven body accelerates by (F_applied + F_reaction) / M.
 // The reaction that drives a force-driven body is measured on the contact set's geometry of t^n,
 // as the contact set was chosen: a node stuck at the body's edge that step 2 carried a hair past
 // it stays in the sum. Before, the balance took the positions of step 2, dropped that node and
@@ -410,6 +409,7 @@ TEST(Contact, ABodysBalanceCountsTheNodesItsContactSetHolds) {
   EXPECT_NEAR((contact.state()[0].velocity[1] - v0) * spec.mass / dt, spec.force[1] + reported, 1e-6 * p);
 }
 
+// Load control: a force-driven body accelerates by (F_applied + F_reaction) / M.
 TEST(Contact, ForceDrivenBodyFollowsItsForceBalance) {
   BodySpec spec = plane(Vec<2>(0.0, 1.0), Vec<2>(0.0, -1.0), ContactLaw::smooth);
   spec.force_driven = {false, true};
