@@ -136,6 +136,33 @@ def main(d):
     fig.savefig(d / "b_face_ux.png", dpi=110)
     plt.close(fig)
 
+    # (b) in 3D: the base stress at the centre and at the edge where two free faces meet, the
+    # finest 2D block beside it, and the closed form.
+    hist3 = sorted(d.glob("b3d_history_dx*.csv"), key=lambda p: -float(dx_of(p, "b3d_history_dx")))
+    if hist3:
+        fig, ax = plt.subplots(figsize=(10, 4.5))
+        for p in hist3:
+            h = read(p)
+            finest = p == hist3[-1]
+            for key, col, where in (("szz_x5", "C1", "(5, 5)"), ("szz_x9.75", "C2", "(9.75, 9.75)")):
+                if not finest and key != "szz_x5":
+                    continue
+                ax.plot(h["t"], [v / 1e3 for v in h[key]], color=col, lw=1, alpha=1.0 if finest else 0.4,
+                        label=f"3D {where} m, dx = {dx_of(p, 'b3d_history_dx')} m")
+        if hist:
+            h2 = read(hist[-1])
+            ax.plot(h2["t"], [v / 1e3 for v in h2["syy_x5"]], color="C0", lw=1, ls=":",
+                    label=f"2D x = 5 m, dx = {dx_of(hist[-1], 'b_history_dx')} m")
+        ax.plot(h["t"], [v / 1e3 for v in h["szz_exact"]], "k--", label="closed form")
+        ax.set_xlabel("t (s)")
+        ax.set_ylabel("base $\\sigma_{zz}$ (kPa)")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7, ncol=2)
+        ax.set_title("Case 4(b) in 3D: base stress of the cube under sudden gravity")
+        fig.tight_layout()
+        fig.savefig(d / "b3d_base_stress.png", dpi=110)
+        plt.close(fig)
+
 
 if __name__ == "__main__":
     main(sys.argv[1])

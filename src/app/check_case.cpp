@@ -47,7 +47,9 @@ std::string check_one(const std::string& file, const std::vector<std::string>& o
     const MaterialPointCase c = load_material_point_case(file, overrides);
     return fmt::format("material point, {} path", c.path_type);
   }
-  if (case_dimension(document) == 1) return check_run_case<1>(document);
+  const int dim = case_dimension(document);
+  if (dim == 1) return check_run_case<1>(document);
+  if (dim == 3) return check_run_case<3>(document);
   return check_run_case<2>(document);
 }
 

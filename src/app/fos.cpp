@@ -92,8 +92,8 @@ double interpolate(const std::vector<double>& t, const std::vector<double>& f, d
 // The trial's histories from its probes.csv and energy.csv, and its classification.
 void classify(Trial& tr, const fos::Monitor& m) {
   const std::string prefix = std::string(fos::kMonitorProbe) + ".";
-  std::vector<std::string> names = {"t", prefix + "ux"};
-  if (m.direction.size() > 1) names.push_back(prefix + "uy");
+  std::vector<std::string> names = {"t"};
+  for (std::size_t d = 0; d < m.direction.size(); ++d) names.push_back(prefix + "u" + std::string(kAxisNames[d]));
   const auto probes = read_columns(tr.folder / "probes.csv", names);
   const auto energy = read_columns(tr.folder / "energy.csv", {"t", m.kinetic_column});
   tr.t = probes[0];

@@ -266,18 +266,33 @@ Monitor resolve(const CaseDocument& doc, const FosTable& f) {
     m.source = "point";
   } else {
     // The default: the crest of a face that looks towards +x, the node of the top row (largest
-    // last coordinate) with the largest x.
+    // last coordinate) with the largest x; in 3D the crest is a line along y, and the node in
+    // the middle of it is taken (the one nearest the crest nodes' mean).
     const double tol = 1e-6 * setup.dx;
     double top = -std::numeric_limits<double>::infinity();
     for (const auto& p : x) top = std::max(top, p[Dim - 1]);
     double best = -std::numeric_limits<double>::infinity();
     for (const auto& p : x) {
-      if (p[Dim - 1] >= top - tol && p[0] > best) {
-        best = p[0];
+      if (p[Dim - 1] >= top - tol) best = std::max(best, p[0]);
+    }
+    Vec<Dim> mean = Vec<Dim>::Zero();
+    int on_crest = 0;
+    for (const auto& p : x) {
+      if (p[Dim - 1] >= top - tol && p[0] >= best - tol) {
+        mean += p;
+        ++on_crest;
+      }
+    }
+    mean /= static_cast<double>(on_crest);
+    double closest = std::numeric_limits<double>::infinity();
+    for (const auto& p : x) {
+      if (p[Dim - 1] >= top - tol && p[0] >= best - tol && (p - mean).norm() < closest) {
+        closest = (p - mean).norm();
         target = p;
       }
     }
-    m.source = "default: the crest (top row, largest x)";
+    m.source = Dim == 3 ? "default: the crest (top row, largest x, middle of the crest line)"
+                        : "default: the crest (top row, largest x)";
   }
   Index nearest = 0;
   double dist = std::numeric_limits<double>::infinity();
@@ -322,7 +337,9 @@ Monitor resolve(const CaseDocument& doc, const FosTable& f) {
 }  // namespace
 
 Monitor resolve_monitor(const CaseDocument& doc, const FosTable& table) {
-  if (case_dimension(doc) == 1) return resolve<1>(doc, table);
+  const int dim = case_dimension(doc);
+  if (dim == 1) return resolve<1>(doc, table);
+  if (dim == 3) return resolve<3>(doc, table);
   return resolve<2>(doc, table);
 }
 
@@ -341,8 +358,8 @@ std::string monitor_probe_override(const CaseDocument& doc, const Monitor& monit
   }
   toml::array position, fields;
   for (double v : monitor.position) position.push_back(v);
-  fields.push_back("ux");
-  if (monitor.position.size() > 1) fields.push_back("uy");
+  // One displacement component per axis: ux, uy, uz.
+  for (std::size_t d = 0; d < monitor.position.size(); ++d) fields.push_back(fmt::format("u{}", kAxisNames[d]));
   toml::table probe;
   probe.insert("name", kMonitorProbe);
   probe.insert("position", std::move(position));

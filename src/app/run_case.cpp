@@ -107,6 +107,7 @@ std::string document_text(const CaseDocument& doc) {
 int dispatch(const LoopInput& input) {
   const int dim = case_dimension(input.document);
   if (dim == 1) return run_loop<1>(input);
+  if (dim == 3) return run_loop<3>(input);
   return run_loop<2>(input);
 }
 

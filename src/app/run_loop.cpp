@@ -747,6 +747,7 @@ int run_loop(const LoopInput& in) {
 
 template int run_loop<1>(const LoopInput&);
 template int run_loop<2>(const LoopInput&);
+template int run_loop<3>(const LoopInput&);
 template Index probe_node<1>(const ProbeSpec&, const ParticleSet<1>&, double);
 template Index probe_node<2>(const ProbeSpec&, const ParticleSet<2>&, double);
 template io::ScalarField probe_field<1>(const ProbeSpec&, const std::string&, const io::FieldCatalogue<1>&);

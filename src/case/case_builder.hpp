@@ -124,6 +124,17 @@ class CaseBuilder {
     c_.initial_velocities = {spec};
     return *this;
   }
+  /// 3D: an initial rigid motion v = velocity + omega x (x - centre).
+  CaseBuilder& initial_velocity(const Vec<Dim>& velocity, const Vec<3>& omega,
+                                const Vec<Dim>& centre) requires(Dim == 3) {
+    InitialVelocitySpec<Dim> spec;
+    spec.where = "CaseBuilder::initial_velocity";
+    spec.velocity = velocity;
+    spec.angular_velocity_vector = omega;
+    spec.centre = centre;
+    c_.initial_velocities = {spec};
+    return *this;
+  }
   CaseBuilder& initial_stress(const Sym6& uniform) {
     c_.initial_stress = InitialStressKind::uniform;
     c_.uniform_stress = uniform;

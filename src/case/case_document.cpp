@@ -187,8 +187,8 @@ int case_dimension(const CaseDocument& doc) {
   io::Section root(doc.table, "", doc.file_label);
   const io::Section g = root.table("geometry");
   const auto d = g.integer("dimension");
-  if (d != 1 && d != 2) {
-    g.fail("dimension", fmt::format("must be 1 or 2 (3D is not available yet), got {}", d));
+  if (d < 1 || d > 3) {
+    g.fail("dimension", fmt::format("must be 1, 2 or 3, got {}", d));
   }
   return static_cast<int>(d);
 }

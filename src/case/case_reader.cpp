@@ -696,5 +696,6 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
 
 template CaseSetup<1> read_case<1>(const CaseDocument&);
 template CaseSetup<2> read_case<2>(const CaseDocument&);
+template CaseSetup<3> read_case<3>(const CaseDocument&);
 
 }  // namespace rktsph

@@ -14,7 +14,16 @@ namespace rktsph::case_reading {
 
 namespace {
 
-/// The keys x, y (each [min, max], m) of a node selector into `region`; false when none is given.
+/// The axes of a Dim-D case, for messages: "x", "x, y" or "x, y, z".
+constexpr std::string_view axis_list(int dim) { return dim == 1 ? "x" : dim == 2 ? "x, y" : "x, y, z"; }
+
+/// The stress components that act on a face of the body, which a boundary entry can prescribe:
+/// in 2D (plane strain) not zz, which acts on no face.
+constexpr std::string_view face_stress_components(int dim) {
+  return dim == 1 ? "xx" : dim == 2 ? "xx, yy, xy" : "xx, yy, zz, xy, yz, xz";
+}
+
+/// The keys x, y, z (each [min, max], m) of a node selector into `region`; false when none is given.
 template <int Dim>
 bool read_axis_ranges(const io::Section& s, Region<Dim>& region) {
   bool any_axis = false;
@@ -46,14 +55,14 @@ BoundarySpec<Dim> read_boundary(const io::Section& b, const CaseSetup<Dim>& c) {
   // A polygon's edge (case/polygon_reader.hpp), or a region.
   const bool by_edge = read_boundary_edge<Dim>(b, c, spec);
   if (!by_edge && !read_axis_ranges(b, spec.region)) {
-    b.fail("", fmt::format("selects no region: give at least one of {} as [min, max]{}", Dim == 1 ? "x" : "x, y",
+    b.fail("", fmt::format("selects no region: give at least one of {} as [min, max]{}", axis_list(Dim),
                            Dim == 2 ? ", or a polygon's edge (polygon, edge)" : ""));
   }
   if (auto v = b.optional_table("velocity")) {
     for (const std::string& axis : v->keys()) {
       const int a = axis_of(axis);
       if (a < 0 || a >= Dim) {
-        v->fail(axis, fmt::format("unknown velocity component (a {}D case has: {})", Dim, Dim == 1 ? "x" : "x, y"));
+        v->fail(axis, fmt::format("unknown velocity component (a {}D case has: {})", Dim, axis_list(Dim)));
       }
       spec.velocity.emplace_back(a, v->number(axis));
     }
@@ -62,11 +71,12 @@ BoundarySpec<Dim> read_boundary(const io::Section& b, const CaseSetup<Dim>& c) {
   if (auto st = b.optional_table("stress")) {
     for (const std::string& comp : st->keys()) {
       // Only the components that act on a face of the body can be prescribed.
-      const bool allowed = comp == "xx" || (Dim >= 2 && (comp == "yy" || comp == "xy"));
+      const bool allowed = comp == "xx" || (Dim >= 2 && (comp == "yy" || comp == "xy")) ||
+                           (Dim == 3 && (comp == "zz" || comp == "yz" || comp == "xz"));
       if (!allowed) {
         st->fail(comp, fmt::format("not a stress component that can be prescribed in {}D "
                                    "(use {})",
-                                   Dim, Dim == 1 ? "xx" : "xx, yy, xy"));
+                                   Dim, face_stress_components(Dim)));
       }
       int slot = -1;
       for (std::size_t i = 0; i < 6; ++i) {
@@ -125,8 +135,14 @@ InitialVelocitySpec<Dim> read_initial_velocity(const io::Section& s, const CaseS
   else
     s.number("velocity", 0.0);
   if (s.has("angular_velocity")) {
-    if (Dim != 2) s.fail("angular_velocity", "a rigid rotation is available in 2D only");
-    spec.angular_velocity = s.number("angular_velocity");
+    // 2D: a number (about e_z); 3D: the vector [wx, wy, wz]; 1D has no rotation.
+    if constexpr (Dim == 1) {
+      s.fail("angular_velocity", "a rigid rotation needs a 2D or 3D case");
+    } else if constexpr (Dim == 2) {
+      spec.angular_velocity = s.number("angular_velocity");
+    } else {
+      spec.angular_velocity_vector = read_vector<3>(s, "angular_velocity");
+    }
     if (s.has("centre"))
       spec.centre = read_vector<Dim>(s, "centre");
     else
@@ -139,7 +155,7 @@ InitialVelocitySpec<Dim> read_initial_velocity(const io::Section& s, const CaseS
     for (const std::string& axis : f->keys()) {
       const int a = axis_of(axis);
       if (a < 0 || a >= Dim) {
-        f->fail(axis, fmt::format("unknown velocity component (a {}D case has: {})", Dim, Dim == 1 ? "x" : "x, y"));
+        f->fail(axis, fmt::format("unknown velocity component (a {}D case has: {})", Dim, axis_list(Dim)));
       }
       const std::string expression = f->string(axis);
       check_position_expression(expression, Dim, f->where(axis));
@@ -239,15 +255,21 @@ typename CaseSetup<Dim>::ImportedParticles read_imported_particles(const CaseDoc
 
 template BoundarySpec<1> read_boundary<1>(const io::Section&, const CaseSetup<1>&);
 template BoundarySpec<2> read_boundary<2>(const io::Section&, const CaseSetup<2>&);
+template BoundarySpec<3> read_boundary<3>(const io::Section&, const CaseSetup<3>&);
 template InitialVelocitySpec<1> read_initial_velocity<1>(const io::Section&, const CaseSetup<1>&);
 template InitialVelocitySpec<2> read_initial_velocity<2>(const io::Section&, const CaseSetup<2>&);
+template InitialVelocitySpec<3> read_initial_velocity<3>(const io::Section&, const CaseSetup<3>&);
 template ProbeSpec read_probe<1>(const io::Section&, const CaseSetup<1>&);
 template ProbeSpec read_probe<2>(const io::Section&, const CaseSetup<2>&);
+template ProbeSpec read_probe<3>(const io::Section&, const CaseSetup<3>&);
 template CaseSetup<1>::ImportedParticles read_imported_particles<1>(const CaseDocument&,
                                                                     const std::vector<io::Section>&,
                                                                     const CaseSetup<1>&);
 template CaseSetup<2>::ImportedParticles read_imported_particles<2>(const CaseDocument&,
                                                                     const std::vector<io::Section>&,
                                                                     const CaseSetup<2>&);
+template CaseSetup<3>::ImportedParticles read_imported_particles<3>(const CaseDocument&,
+                                                                    const std::vector<io::Section>&,
+                                                                    const CaseSetup<3>&);
 
 }  // namespace rktsph::case_reading

@@ -72,8 +72,10 @@ struct InitialVelocitySpec {
   Vec<Dim> velocity = Vec<Dim>::Zero();  // m/s
   /// 2D: v += omega e_z x (x - centre) (rad/s, counter-clockwise positive).
   double angular_velocity = 0.0;
+  /// 3D: v += omega x (x - centre), omega the angular velocity vector (rad/s, right-handed).
+  Vec<3> angular_velocity_vector = Vec<3>::Zero();
   Vec<Dim> centre = Vec<Dim>::Zero();
-  /// A function of the initial position per component (muparser syntax in x, y; m/s), added to
+  /// A function of the initial position per component (muparser syntax in x, y, z; m/s), added to
   /// the rest; empty: none.
   std::array<std::string, Dim> expression{};
 };

@@ -6,6 +6,7 @@
 
 #include <fmt/format.h>
 #include <muParser.h>
+#include <Eigen/Geometry>
 
 #include "core/error.hpp"
 
@@ -13,7 +14,7 @@ namespace rktsph {
 
 namespace {
 
-/// One parser bound to the variables x, y of `position`.
+/// One parser bound to the variables x, y, z of `position` (as many as the dimension).
 std::unique_ptr<mu::Parser> make_parser(const std::string& expression, int dim, std::array<double, 3>& position) {
   auto p = std::make_unique<mu::Parser>();
   p->DefineVar("x", &position[0]);
@@ -33,7 +34,10 @@ void check_position_expression(const std::string& expression, int dim, const std
     value = p->Eval();
   } catch (const mu::Parser::exception_type& e) {
     throw InputError(fmt::format("{}: cannot evaluate '{}': {} (variables: {}; constants _pi, _e)", where, expression,
-                                 e.GetMsg(), dim == 1 ? "x" : "x, y"));
+                                 e.GetMsg(),
+                                 dim == 1   ? "x"
+                                 : dim == 2 ? "x, y"
+                                            : "x, y, z"));
   }
   if (!std::isfinite(value)) {
     throw InputError(fmt::format("{}: '{}' is not finite at x = 0", where, expression));
@@ -74,6 +78,8 @@ Vec<Dim> InitialVelocityField<Dim>::at(const Vec<Dim>& x, int material) const {
         v[0] -= s.angular_velocity * r[1];
         v[1] += s.angular_velocity * r[0];
       }
+    } else if constexpr (Dim == 3) {
+      v += s.angular_velocity_vector.cross(x - s.centre);
     }
     const auto& c = *compiled_[k];
     for (int d = 0; d < Dim; ++d) c.position[static_cast<std::size_t>(d)] = x[d];

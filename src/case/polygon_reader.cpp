@@ -128,7 +128,9 @@ bool read_boundary_edge(const io::Section& b, const CaseSetup<Dim>& c, BoundaryS
 
 template void read_polygons<1>(const io::Section&, const std::vector<io::Section>&, CaseSetup<1>&);
 template void read_polygons<2>(const io::Section&, const std::vector<io::Section>&, CaseSetup<2>&);
+template void read_polygons<3>(const io::Section&, const std::vector<io::Section>&, CaseSetup<3>&);
 template bool read_boundary_edge<1>(const io::Section&, const CaseSetup<1>&, BoundarySpec<1>&);
 template bool read_boundary_edge<2>(const io::Section&, const CaseSetup<2>&, BoundarySpec<2>&);
+template bool read_boundary_edge<3>(const io::Section&, const CaseSetup<3>&, BoundarySpec<3>&);
 
 }  // namespace rktsph::case_reading

@@ -101,6 +101,78 @@ end = 1.0
 cfl = 0.5
 )";
 
+// 3D (geometry.dimension = 3): a viscoplastic block on a rough base under a gravity ramp (V1),
+// and a cohesive column slumping, its free surface detected (V2).
+const char* kV1In3D = R"(
+[geometry]
+dimension = 3
+spacing = 0.25
+[[geometry.block]]
+min = [0.0, 0.0, 0.0]
+max = [2.0, 1.0, 1.5]
+[material]
+model = "perzyna_von_mises"
+E = 1.0e7
+nu = 0.3
+density = 2000.0
+cohesion = 4.0e3
+fluidity = 5.0
+[body_force]
+gravity = [0.0, 0.0, -9.81]
+function = "ramp"
+[functions.ramp]
+type = "ramp"
+duration = 0.2
+[[boundary]]
+z = [0.0, 0.0]
+velocity = { x = 0.0, y = 0.0, z = 0.0 }
+[[boundary]]
+x = [0.0, 0.0]
+velocity = { x = 0.0 }
+[[probe]]
+name = "crest"
+position = [2.0, 0.5, 1.5]
+fields = ["ux", "uz", "q", "eps_vp_eq"]
+[output]
+interval = 0.05
+checkpoint_interval = 0.1
+[time]
+end = 0.8
+cfl = 0.5
+)";
+
+const char* kV2In3D = R"(
+[geometry]
+dimension = 3
+spacing = 0.1
+[[geometry.block]]
+min = [0.0, 0.0, 0.0]
+max = [0.6, 0.3, 0.9]
+[material]
+model = "perzyna_von_mises"
+E = 1.0e7
+nu = 0.3
+density = 2000.0
+cohesion = 2.0e3
+fluidity = 5.0
+[body_force]
+gravity = [0.0, 0.0, -9.81]
+[[boundary]]
+z = [0.0, 0.0]
+velocity = { x = 0.0, y = 0.0, z = 0.0 }
+[[probe]]
+name = "crest"
+position = [0.6, 0.3, 0.9]
+fields = ["ux", "uz", "q"]
+[output]
+interval = 0.05
+[solver]
+version = "v2"
+[time]
+end = 0.4
+cfl = 0.5
+)";
+
 const char* kV3 = R"(
 [geometry]
 dimension = 2
@@ -240,6 +312,10 @@ void interrupt_and_resume(const char* text, int signal, int resume_threads, unsi
 TEST(Resume, V1InterruptedBySigtermResumesBitForBitOnAnotherThreadCount) { interrupt_and_resume(kV1, SIGTERM, 1, 11); }
 
 TEST(Resume, V3InterruptedBySigintResumesBitForBit) { interrupt_and_resume(kV3, SIGINT, 2, 12); }
+
+// 3D: the reference on one thread, the interrupted run on two, resumed on one or two.
+TEST(Resume, V1In3DResumesBitForBitOnAnotherThreadCount) { interrupt_and_resume(kV1In3D, SIGTERM, 1, 14); }
+TEST(Resume, V2In3DResumesBitForBit) { interrupt_and_resume(kV2In3D, SIGINT, 2, 15); }
 
 // V2 carries the free-surface flags of the last step (their temporal coherence) in the
 // checkpoint, and rebuilds its Verlet lists on resume.

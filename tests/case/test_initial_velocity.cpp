@@ -6,6 +6,8 @@
 #include <cmath>
 #include <string>
 
+#include <Eigen/Geometry>
+
 #include "../support/test_util.hpp"
 #include "core/error.hpp"
 #include "schemes/simulation.hpp"
@@ -87,6 +89,43 @@ function = { x = "-x", y = "10*y + x^2" }
     EXPECT_NEAR(v(i, 1), expected[1], 1e-14) << x.transpose();
   }
   EXPECT_EQ(in_box, 4) << "2 x 2 lattice nodes in the corner box";
+}
+
+// 3D: a rigid rotation about an axis through a centre, v = omega x (x - c), and a function of
+// x, y, z added to it.
+TEST(InitialVelocity, ARigidRotationIn3DIsTheCrossProduct) {
+  const test::TempDir dir;
+  const Simulation<3> sim(test::case_from_string<3>(dir, R"(
+[geometry]
+dimension = 3
+spacing = 0.25
+[[geometry.block]]
+min = [0.0, 0.0, 0.0]
+max = [1.0, 0.5, 0.75]
+[material]
+model = "elastic"
+E = 1.0e7
+nu = 0.3
+density = 2000.0
+[time]
+end = 0.001
+[solver]
+version = "v2"
+[initial_velocity]
+angular_velocity = [0.5, -1.0, 2.0]
+centre = [0.5, 0.25, 0.25]
+velocity = [0.1, 0.0, 0.0]
+function = { z = "x*y*z" }
+)"));
+  const Vec<3> omega(0.5, -1.0, 2.0), centre(0.5, 0.25, 0.25);
+  const auto v = sim.node_velocity();
+  ASSERT_EQ(sim.nodes().size(), 5 * 3 * 4);
+  for (Index i = 0; i < static_cast<Index>(sim.nodes().size()); ++i) {
+    const Vec<3> x = sim.nodes().position[static_cast<std::size_t>(i)];
+    Vec<3> expected = Vec<3>(0.1, 0.0, 0.0) + omega.cross(x - centre);
+    expected[2] += x[0] * x[1] * x[2];
+    for (int d = 0; d < 3; ++d) EXPECT_NEAR(v(i, d), expected[d], 1e-14) << x.transpose();
+  }
 }
 
 TEST(InitialVelocity, NodesNoEntrySelectsStartAtRest) {

@@ -841,5 +841,74 @@ TEST(InputErrors, MaterialPointSetIsCheckedLikeRun) {
   }
 }
 
+// The base case as a 3D block (geometry.dimension = 3).
+std::string base_3d() {
+  std::string t = replace(kBase, "dimension = 2", "dimension = 3");
+  t = replace(t, "min = [0.0, 0.0]", "min = [0.0, 0.0, 0.0]");
+  t = replace(t, "max = [2.0, 1.0]", "max = [2.0, 1.0, 1.0]");
+  t = replace(t, "y = [0.0, 0.0]\nvelocity = { x = 0.0, y = 0.0 }",
+              "z = [0.0, 0.0]\nvelocity = { x = 0.0, y = 0.0, z = 0.0 }");
+  return replace(t, "position = [2.0, 1.0]", "position = [2.0, 1.0, 1.0]");
+}
+
+TEST(InputErrors, ThreeDimensionalCases) {
+  test::TempDir dir;
+  {
+    const auto o = run_case_text(dir, base_3d());
+    EXPECT_EQ(o.status, 0) << o.err;
+  }
+  {
+    const std::string text = replace(kBase, "dimension = 2", "dimension = 4");
+    const auto o = run_case_text(dir, text);
+    expect_error_at(o, line_of(text, "dimension = "), "geometry.dimension", {"must be 1, 2 or 3", "got 4"});
+  }
+  {
+    // A 2D probe position in a 3D case.
+    const std::string text = replace(base_3d(), "position = [2.0, 1.0, 1.0]", "position = [2.0, 1.0]");
+    const auto o = run_case_text(dir, text);
+    expect_error_at(o, line_of(text, "position = [2.0, 1.0]"), "probe[0].position", {"3 coordinates", "3D"});
+  }
+  {
+    // A 2D block corner in a 3D case.
+    const std::string text = replace(base_3d(), "max = [2.0, 1.0, 1.0]", "max = [2.0, 1.0]");
+    const auto o = run_case_text(dir, text);
+    expect_error_at(o, line_of(text, "max = [2.0, 1.0]"), "geometry.block[0].max", {"3"});
+  }
+  {
+    const std::string text =
+        replace(base_3d(), "velocity = { x = 0.0, y = 0.0, z = 0.0 }", "velocity = { x = 0.0, w = 0.0 }");
+    const auto o = run_case_text(dir, text);
+    expect_input_error(o, "boundary[0].velocity.w", {"unknown velocity component", "x, y, z"});
+  }
+  {
+    // A 3D face takes every stress component; 2D (plane strain) not zz, which acts on no face.
+    const std::string face =
+        "[[boundary]]\nname = \"top\"\nz = [1.0, 1.0]\nstress = { zz = -1.0e3, yz = 0.0, xz = 0.0 }\n";
+    EXPECT_EQ(run_case_text(dir, base_3d() + face).status, 0);
+    const std::string text =
+        std::string(kBase) + "[[boundary]]\nname = \"top\"\ny = [1.0, 1.0]\nstress = { zz = -1.0e3 }\n";
+    const auto o = run_case_text(dir, text);
+    expect_input_error(o, "boundary[1].stress.zz", {"can be prescribed in 2D", "xx, yy, xy"});
+  }
+  {
+    const std::string text = base_3d() + "[[body]]\nname = \"plate\"\n";
+    const auto o = run_case_text(dir, text);
+    expect_input_error(o, "body", {"2D only"});
+  }
+  {
+    std::string text = replace(base_3d(), "[[geometry.block]]\nmin = [0.0, 0.0, 0.0]\nmax = [2.0, 1.0, 1.0]\n",
+                               "[[geometry.polygon]]\nvertices = [[0.0, 0.0], [2.0, 0.0], [2.0, 1.0]]\n");
+    const auto o = run_case_text(dir, text);
+    expect_input_error(o, "geometry.polygon[0]", {"two-dimensional", "geometry.dimension = 2"});
+  }
+  {
+    // 3D: the angular velocity is a vector.
+    EXPECT_EQ(run_case_text(dir, base_3d() + "[initial_velocity]\nangular_velocity = [0.0, 0.0, 1.0]\n").status, 0);
+    const std::string text = base_3d() + "[initial_velocity]\nangular_velocity = 1.0\n";
+    const auto o = run_case_text(dir, text);
+    expect_input_error(o, "initial_velocity.angular_velocity", {"3"});
+  }
+}
+
 }  // namespace
 }  // namespace rktsph

@@ -429,6 +429,85 @@ cfl = 0.5
   EXPECT_LT(worst, 0.02);
 }
 
+// The same strip as a 3D prism (0.6 m x 0.6 m x 4 m, rollers and impermeable walls on all four
+// sides): still a 1D column, in the mirror images of two pairs of walls and along their edges.
+TEST(Saturated, ThreeDimensionalPrismConsolidatesLikeTerzaghi) {
+  test::ThreadCount one(1);
+  test::TempDir dir;
+  const std::string text = R"(
+[geometry]
+dimension = 3
+spacing = 0.2
+[[geometry.block]]
+min = [0.0, 0.0, 0.0]
+max = [0.6, 0.6, 4.0]
+[material]
+model = "elastic"
+E = 3.0e7
+nu = 0.2
+density = 1700.0
+[fluid]
+porosity = 0.3
+density = 1000.0
+bulk_modulus = 1.0e8
+conductivity = 1.0e-3
+[solver]
+version = "v3"
+[functions.load]
+type = "ramp"
+duration = 0.5
+[[boundary]]
+name = "x_walls"
+x = [0.0, 0.0]
+velocity = { x = 0.0 }
+[[boundary]]
+name = "x_walls_far"
+x = [0.6, 0.6]
+velocity = { x = 0.0 }
+[[boundary]]
+name = "y_walls"
+y = [0.0, 0.0]
+velocity = { y = 0.0 }
+[[boundary]]
+name = "y_walls_far"
+y = [0.6, 0.6]
+velocity = { y = 0.0 }
+[[boundary]]
+name = "base"
+z = [0.0, 0.0]
+velocity = { x = 0.0, y = 0.0, z = 0.0 }
+impermeable = true
+[[boundary]]
+name = "top"
+z = [4.0, 4.0]
+stress = { zz = -5.0e3, xz = 0.0, yz = 0.0 }
+pore_pressure = 0.0
+function = "load"
+[time]
+end = 3.0
+cfl = 0.5
+)";
+  auto setup = test::case_from_string<3>(dir, text);
+  Simulation<3> solver(setup);
+  while (solver.time() < 3.0 - 1e-9) solver.step();
+  analytic::SaturatedColumn col;
+  col.height = 4.0;
+  col.constrained = kM;
+  col.storage = kQ;
+  col.permeability = 1.0e-3 / (1000.0 * 9.81);
+  col.density = kRho;
+  const analytic::Terzaghi ref{col, 5.0e3, 0.5};
+  const double p0 = 5.0e3 * col.skempton();
+  double worst = 0.0;
+  const auto& nodes = solver.nodes();
+  for (std::size_t i = 0; i < static_cast<std::size_t>(nodes.size()); ++i) {
+    const double depth = 4.0 - nodes.position[i][2];
+    worst = std::max(worst, std::abs(solver.node_pore_pressure()[i] - ref.pressure(depth, solver.time())) / p0);
+  }
+  std::printf("3D prism at T_v = 0.58: largest |p_w - Terzaghi| / p0 = %.4f\n", worst);
+  EXPECT_LT(worst, 0.02);
+}
+
 // An undrained strip (0.6 m wide, 4 m high, lateral rollers, fixed base, every face
 // impermeable, k = 0) loaded by its own weight: p_w must carry Q/(M+Q) of the total vertical
 // stress, -gamma (H - y), and keep it while the weight is held. The non-incremental projection
