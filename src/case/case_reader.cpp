@@ -205,9 +205,10 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
     } else if (type == "uniform") {
       // A uniform initial stress, Pa (tension positive), e.g. an isotropic confinement.
       c.initial_stress = InitialStressKind::uniform;
-      const std::vector<std::string> comps =
-          Dim == 1 ? std::vector<std::string>{"xx", "yy", "zz"} : std::vector<std::string>{"xx", "yy", "zz", "xy"};
-      for (std::size_t i = 0; i < comps.size(); ++i) c.uniform_stress[i == 3 ? 3 : i] = is->number(comps[i], 0.0);
+      // The components a Dim-D state carries (kStressComponentNames order: xx, yy, zz, xy, yz, xz).
+      const std::size_t count = Dim == 1 ? 3 : Dim == 2 ? 4 : 6;
+      for (std::size_t i = 0; i < count; ++i)
+        c.uniform_stress[i] = is->number(std::string(kStressComponentNames[i]), 0.0);
     } else {
       is->fail("type", fmt::format("unknown initial stress '{}' (known: zero, geostatic, uniform)", type));
     }
