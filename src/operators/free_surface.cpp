@@ -439,10 +439,10 @@ void detect_free_surface(const ParticleSet<Dim>& set, const Relation<Dim>& relat
       if (flags[iu] != 0) normals[iu] = improved[static_cast<std::size_t>(k)];
     }
   } else if constexpr (Dim == 3) {
-    // Step 4 in 3D: the same from the chords to the nearest partner in each quarter of the
-    // tangent plane of the first normal (about +t1, +t2, -t1, -t2): the normal is the mean of
-    // the normals of the four triangles that consecutive chords span, each turned to the first
-    // normal's side (a vertex normal). Beside an edge the nearest partner across it is the edge
+    // Step 4 in 3D (method-notes eq. (3.6.6)): the same from the chords to the nearest partner
+    // in each quarter of the tangent plane of the first normal (about +t1, +t2, -t1, -t2): the
+    // normal is the mean of the normals of the four triangles that consecutive chords span,
+    // each turned to the first normal's side (a vertex normal). Beside an edge the nearest partner across it is the edge
     // node, which lies in the face's plane, so the row next to an edge gets its face's normal,
     // where the first normal leans towards the other face. At an edge or a corner the triangles'
     // normals are those of the faces that meet there and their mean bisects them; 3D has no

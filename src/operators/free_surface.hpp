@@ -9,6 +9,8 @@
 //      node interior;
 //   4. 2D: the improved normal, from the perpendiculars to the chords to the two adjacent surface
 //      nodes (one on either side); a corner where those two differ by more than kCornerTurn;
+//      3D: from the triangles that the chords to the nearest partner in each quarter of the
+//      tangent plane span (method-notes eq. (3.6.6)), no corners;
 //   5. temporal coherence: a node that was not on the surface may become one only next to a
 //      node that was, or with lambda_I <= surface_below (a genuinely new surface);
 //   6. nodes excluded by the caller (explicit boundary conditions) are never flagged;
