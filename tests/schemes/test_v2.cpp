@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <random>
 #include <utility>
 
@@ -21,6 +22,7 @@
 #include "schemes/motion.hpp"
 #include "schemes/simulation.hpp"
 #include "schemes/v2_stages.hpp"
+#include "validation/analytic.hpp"
 
 namespace rktsph {
 namespace {
@@ -306,6 +308,155 @@ namespace {
 // Sorting the particles into Morton order (solver.sort, method-notes §3.8) changes where they
 // are stored, not what they do: a spinning square with its free surface detected, run sorted
 // and unsorted, ends with the same state particle by particle (by global id) to round-off.
+// Case 7's pushed bar in 3D (docs/cases.md Case 7): a prism 10 m x 0.1 m x 0.1 m, dx = 0.05 m,
+// rollers on its four long faces (uniaxial strain), pushed at v0 = 0.2 C0 at x = 0 and fixed at
+// x = 10 m, run by V2 to 0.12 s. Its centre line must carry Case 7's exact shock (sigma = M ln
+// lambda, lambda1 = 0.81008, S = 1.0531 C0) as the 1D bar does: the same acceptance (shock
+// within 2 dx, plateau lambda and sigma within 2 %) and, point by point, the 1D run's profile.
+TEST(V2, ALargeStrainBarIn3DCarriesTheExactShock) {
+  const test::ThreadCount threads(2);
+  const test::TempDir dir;
+  const double M = 1.0e7, rho = 2000.0, c0 = std::sqrt(M / rho), v0 = 0.2 * c0, dx = 0.05, end = 0.12;
+  const std::string materials = R"(
+[material]
+model = "elastic"
+E = 1.0e7
+nu = 0.0
+density = 2000.0
+[solver]
+version = "v2"
+[time]
+end = 0.12
+cfl = 0.5
+)";
+  const std::string bar_3d = fmt::format(R"(
+[geometry]
+dimension = 3
+spacing = {dx}
+[[geometry.block]]
+min = [0.0, 0.0, 0.0]
+max = [10.0, 0.1, 0.1]
+[[boundary]]
+name = "piston"
+x = [0.0, 0.0]
+velocity = {{ x = {v0:.17g} }}
+[[boundary]]
+name = "fixed end"
+x = [10.0, 10.0]
+velocity = {{ x = 0.0 }}
+[[boundary]]
+y = [0.0, 0.0]
+velocity = {{ y = 0.0 }}
+[[boundary]]
+y = [0.1, 0.1]
+velocity = {{ y = 0.0 }}
+[[boundary]]
+z = [0.0, 0.0]
+velocity = {{ z = 0.0 }}
+[[boundary]]
+z = [0.1, 0.1]
+velocity = {{ z = 0.0 }}
+)",
+                                         fmt::arg("dx", dx), fmt::arg("v0", v0)) +
+                             materials;
+  const std::string bar_1d = fmt::format(R"(
+[geometry]
+dimension = 1
+spacing = {dx}
+[[geometry.block]]
+min = [0.0]
+max = [10.0]
+[[boundary]]
+name = "piston"
+x = [0.0, 0.0]
+velocity = {{ x = {v0:.17g} }}
+[[boundary]]
+name = "fixed end"
+x = [10.0, 10.0]
+velocity = {{ x = 0.0 }}
+)",
+                                         fmt::arg("dx", dx), fmt::arg("v0", v0)) +
+                             materials;
+  // The profile along the bar: X (initial x), x, sigma_xx of the nodes that `on_line` selects by
+  // their initial position, in order of X.
+  struct Line {
+    std::vector<double> X, x, sigma;
+  };
+  auto line_of = [](const auto& sim, const auto& made, auto&& on_line) {
+    std::vector<std::pair<double, std::size_t>> pick;
+    const auto& nodes = sim.nodes();
+    for (std::size_t i = 0; i < nodes.position.size(); ++i) {
+      const auto& x0 = made[static_cast<std::size_t>(nodes.global_id[i])];
+      if (on_line(x0)) pick.emplace_back(x0[0], i);
+    }
+    std::sort(pick.begin(), pick.end());
+    Line l;
+    for (const auto& [X, i] : pick) {
+      l.X.push_back(X);
+      l.x.push_back(nodes.position[i][0]);
+      l.sigma.push_back(sim.node_stress()(i, StressComponent::xx));
+    }
+    return l;
+  };
+  Simulation<3> sim3(test::case_from_string<3>(dir, bar_3d));
+  const std::vector<Vec<3>> made3 = sim3.nodes().position;
+  while (sim3.time() < end - 1e-12) sim3.step();
+  const Line l3 = line_of(sim3, made3,
+                          [](const Vec<3>& p) { return std::abs(p[1] - 0.05) < 1e-9 && std::abs(p[2] - 0.05) < 1e-9; });
+  Simulation<1> sim1(test::case_from_string<1>(dir, bar_1d));
+  const std::vector<Vec<1>> made1 = sim1.nodes().position;
+  while (sim1.time() < end - 1e-12) sim1.step();
+  const Line l1 = line_of(sim1, made1, [](const Vec<1>&) { return true; });
+  ASSERT_EQ(l3.X.size(), 201u);
+  ASSERT_EQ(l1.X.size(), 201u);
+  EXPECT_EQ(sim3.time(), sim1.time());
+
+  const analytic::LargeStrainBar exact{M, rho, v0};
+  const double lambda1 = exact.lambda_behind(), sigma1 = M * std::log(lambda1), shock = exact.shock_speed() * end;
+  // The front: where sigma first rises above half the jump, from the piston.
+  auto front = [&](const Line& l) {
+    for (std::size_t k = 0; k + 1 < l.X.size(); ++k) {
+      const double a = l.sigma[k] / sigma1, b = l.sigma[k + 1] / sigma1;
+      if (a >= 0.5 && b < 0.5) return l.X[k] + (a - 0.5) / (a - b) * (l.X[k + 1] - l.X[k]);
+    }
+    return std::numeric_limits<double>::quiet_NaN();
+  };
+  // The plateau between 1 m and 1 m behind the shock: lambda by central differences, sigma.
+  auto plateau = [&](const Line& l, double& lam, double& sig) {
+    double sl = 0.0, ss = 0.0;
+    int n = 0;
+    for (std::size_t k = 1; k + 1 < l.X.size(); ++k) {
+      if (l.X[k] < 1.0 || l.X[k] > shock - 1.0) continue;
+      sl += (l.x[k + 1] - l.x[k - 1]) / (l.X[k + 1] - l.X[k - 1]);
+      ss += l.sigma[k];
+      ++n;
+    }
+    lam = sl / n;
+    sig = ss / n;
+  };
+  double lam3 = 0.0, sig3 = 0.0, lam1 = 0.0, sig1 = 0.0;
+  plateau(l3, lam3, sig3);
+  plateau(l1, lam1, sig1);
+  // The whole profile against the exact one: the mean |sigma - sigma_exact| along the bar over
+  // the jump, the two end nodes left out (as by Case 7's density criterion), for both runs.
+  auto l1_error = [&](const Line& l) {
+    double sum = 0.0;
+    for (std::size_t k = 1; k + 1 < l.X.size(); ++k) sum += std::abs(l.sigma[k] - exact.stress(l.X[k], end));
+    return sum / static_cast<double>(l.X.size() - 2) / std::abs(sigma1);
+  };
+  std::printf(
+      "3D bar at %.2f s: shock at %.4f m (exact %.4f, 1D %.4f), %.2f dx off; plateau lambda %.5f (exact %.5f, 1D "
+      "%.5f), "
+      "sigma %.4f MPa (exact %.4f, 1D %.4f); mean |sigma - exact| / jump %.4f (1D %.4f)\n",
+      end, front(l3), shock, front(l1), std::abs(front(l3) - shock) / dx, lam3, lambda1, lam1, sig3 / 1e6, sigma1 / 1e6,
+      sig1 / 1e6, l1_error(l3), l1_error(l1));
+  EXPECT_LT(std::abs(front(l3) - shock), 2.0 * dx);
+  EXPECT_LT(std::abs(lam3 / lambda1 - 1.0), 0.02);
+  EXPECT_LT(std::abs(sig3 / sigma1 - 1.0), 0.02);
+  EXPECT_LT(std::abs(front(l3) - front(l1)), 0.5 * dx);
+  EXPECT_LT(l1_error(l3), 1.1 * l1_error(l1));
+}
+
 TEST(V2Sort, SortedAndUnsortedRunsAgreeParticleByParticle) {
   const test::ThreadCount threads(1);
   auto run = [](bool sort) {
