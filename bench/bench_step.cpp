@@ -145,6 +145,21 @@ BENCHMARK(BM_V1Step)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 
+// The measured loop of a step benchmark: one step an iteration, then the node count and the
+// rate of node-steps. Returns the node count.
+template <int Dim>
+double time_steps(benchmark::State& state, Simulation<Dim>& solver) {
+  for (auto _ : state) {
+    solver.step();
+    benchmark::ClobberMemory();
+  }
+  const double nodes = static_cast<double>(solver.nodes().size());
+  state.counters["nodes"] = nodes;
+  state.counters["node_steps/s"] =
+      benchmark::Counter(nodes * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  return nodes;
+}
+
 // The V1 step in 3D: a cube of about `nodes` nodes, fixed base, loaded top (the 2D block of
 // BM_V1Step one dimension up). A 3D node has about 3.4 times the pairs of a 2D one.
 void BM_V1Step3D(benchmark::State& state) {
@@ -159,14 +174,7 @@ void BM_V1Step3D(benchmark::State& state) {
       .prescribe_stress(Region<3>::plane(2, length), StressComponent::zz, -1.0e4)
       .time(1.0, 0.9);
   Simulation<3> solver(b.build());
-  for (auto _ : state) {
-    solver.step();
-    benchmark::ClobberMemory();
-  }
-  const double nodes = static_cast<double>(solver.nodes().size());
-  state.counters["nodes"] = nodes;
-  state.counters["node_steps/s"] =
-      benchmark::Counter(nodes * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  const double nodes = time_steps(state, solver);
   state.counters["pairs/node"] = static_cast<double>(solver.pairs()) / nodes;
   state.counters["state_B/node"] = static_cast<double>(solver.state_bytes()) / nodes;
   state.counters["operator_B/node"] = static_cast<double>(solver.operator_bytes()) / nodes;
@@ -374,14 +382,7 @@ void BM_V2Step3D(benchmark::State& state) {
   Simulation<3> solver(setup);
   if (storage >= 2) solver.reorder(shuffled_orders(solver.nodes().size(), solver.stress_points().size(), 12345));
   for (int k = 0; k < 3; ++k) solver.step();
-  for (auto _ : state) {
-    solver.step();
-    benchmark::ClobberMemory();
-  }
-  const double nodes = static_cast<double>(solver.nodes().size());
-  state.counters["nodes"] = nodes;
-  state.counters["node_steps/s"] =
-      benchmark::Counter(nodes * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  time_steps(state, solver);
   state.counters["sorts"] = static_cast<double>(solver.reorders());
 }
 BENCHMARK(BM_V2Step3D)

@@ -116,23 +116,13 @@ class CaseBuilder {
   /// 2D: an initial rigid motion v = velocity + omega e_z x (x - centre).
   CaseBuilder& initial_velocity(const Vec<Dim>& velocity, double omega = 0.0,
                                 const Vec<Dim>& centre = Vec<Dim>::Zero()) {
-    InitialVelocitySpec<Dim> spec;
-    spec.where = "CaseBuilder::initial_velocity";
-    spec.velocity = velocity;
-    spec.angular_velocity = omega;
-    spec.centre = centre;
-    c_.initial_velocities = {spec};
+    rigid_motion(velocity, centre).angular_velocity = omega;
     return *this;
   }
   /// 3D: an initial rigid motion v = velocity + omega x (x - centre).
   CaseBuilder& initial_velocity(const Vec<Dim>& velocity, const Vec<3>& omega,
                                 const Vec<Dim>& centre) requires(Dim == 3) {
-    InitialVelocitySpec<Dim> spec;
-    spec.where = "CaseBuilder::initial_velocity";
-    spec.velocity = velocity;
-    spec.angular_velocity_vector = omega;
-    spec.centre = centre;
-    c_.initial_velocities = {spec};
+    rigid_motion(velocity, centre).angular_velocity_vector = omega;
     return *this;
   }
   CaseBuilder& initial_stress(const Sym6& uniform) {
@@ -251,6 +241,15 @@ class CaseBuilder {
   }
 
  private:
+  // The one initial-velocity entry of a rigid motion, its rotation left to the caller.
+  InitialVelocitySpec<Dim>& rigid_motion(const Vec<Dim>& velocity, const Vec<Dim>& centre) {
+    InitialVelocitySpec<Dim> spec;
+    spec.where = "CaseBuilder::initial_velocity";
+    spec.velocity = velocity;
+    spec.centre = centre;
+    c_.initial_velocities = {spec};
+    return c_.initial_velocities.front();
+  }
   struct PendingBlock {
     Vec<Dim> min, max;
     std::string material;

@@ -392,103 +392,92 @@ void detect_free_surface(const ParticleSet<Dim>& set, const Relation<Dim>& relat
       for (Index k = 0; k < count; ++k) (*corners)[static_cast<std::size_t>(which[k])] = 0;
     }
   }
-  if constexpr (Dim == 2) {
+  // Step 4 in 3D (method-notes eq. (3.6.6)): the same from the chords to the nearest partner in
+  // each quarter of the tangent plane of the first normal (about +t1, +t2, -t1, -t2): the normal
+  // is the mean of the normals of the four triangles that consecutive chords span, each turned to
+  // the first normal's side (a vertex normal). Beside an edge the nearest partner across it is the
+  // edge node, which lies in the face's plane, so the row next to an edge gets its face's normal,
+  // where the first normal leans towards the other face. At an edge or a corner the triangles'
+  // normals are those of the faces that meet there and their mean bisects them; 3D has no corner
+  // condition (corners stay 0).
+  if constexpr (Dim >= 2) {
     const double corner_cos = std::cos(kCornerTurn);
     std::vector<Vec<Dim>>& improved = work.improved;
     improved.resize(static_cast<std::size_t>(count));
+    // Node j as a partner of surface node i: a flagged neighbour, or an excluded one that is not
+    // plainly interior (a wall's surface node).
+    auto partner = [&](Index i, Index j) {
+      const auto ju = static_cast<std::size_t>(j);
+      if (j == i || set.volume[ju] == 0.0) return false;
+      return flags[ju] != 0 || (!excluded.empty() && excluded[ju] != 0 && lambda[ju] <= options.interior_above);
+    };
     exec::particle_for(policy, count, [&](Index k) {
       const Index i = which != nullptr ? which[k] : k;
       const auto iu = static_cast<std::size_t>(i);
       improved[static_cast<std::size_t>(k)] = normals[iu];
       if (flags[iu] == 0) return;
       const Vec<Dim> n0 = normals[iu];
-      const Vec<Dim> tangent(-n0[1], n0[0]);
-      double best[2] = {r2, r2};
-      Vec<Dim> chord[2] = {Vec<Dim>::Zero(), Vec<Dim>::Zero()};
-      for (const Index j : relation.row(i)) {
-        const auto ju = static_cast<std::size_t>(j);
-        if (j == i || set.volume[ju] == 0.0) continue;
-        const bool partner =
-            flags[ju] != 0 || (!excluded.empty() && excluded[ju] != 0 && lambda[ju] <= options.interior_above);
-        if (!partner) continue;
-        const Vec<Dim> c = set.position[ju] - set.position[iu];
-        const double d2 = c.squaredNorm();
-        const double along = tangent.dot(c);
-        if (along == 0.0) continue;
-        const int side = along > 0.0 ? 0 : 1;
-        if (d2 < best[side]) {
-          best[side] = d2;
-          chord[side] = c;
+      if constexpr (Dim == 2) {
+        const Vec<Dim> tangent(-n0[1], n0[0]);
+        double best[2] = {r2, r2};
+        Vec<Dim> chord[2] = {Vec<Dim>::Zero(), Vec<Dim>::Zero()};
+        for (const Index j : relation.row(i)) {
+          if (!partner(i, j)) continue;
+          const Vec<Dim> c = set.position[static_cast<std::size_t>(j)] - set.position[iu];
+          const double d2 = c.squaredNorm();
+          const double along = tangent.dot(c);
+          if (along == 0.0) continue;
+          const int side = along > 0.0 ? 0 : 1;
+          if (d2 < best[side]) {
+            best[side] = d2;
+            chord[side] = c;
+          }
         }
-      }
-      Vec<Dim> p[2];
-      int found = 0;
-      for (int side = 0; side < 2; ++side) {
-        if (chord[side].squaredNorm() == 0.0) continue;
-        Vec<Dim> q(-chord[side][1], chord[side][0]);
-        if (q.dot(n0) < 0.0) q = -q;
-        p[found++] = q.normalized();
-      }
-      if (found == 0) return;
-      const Vec<Dim> sum = found == 2 ? Vec<Dim>(p[0] + p[1]) : p[0];
-      if (sum.norm() > 0.0) improved[static_cast<std::size_t>(k)] = sum / sum.norm();
-      if (found == 2 && corners != nullptr && p[0].dot(p[1]) < corner_cos) (*corners)[iu] = 1;
-    });
-    for (Index k = 0; k < count; ++k) {
-      const auto iu = static_cast<std::size_t>(which != nullptr ? which[k] : k);
-      if (flags[iu] != 0) normals[iu] = improved[static_cast<std::size_t>(k)];
-    }
-  } else if constexpr (Dim == 3) {
-    // Step 4 in 3D (method-notes eq. (3.6.6)): the same from the chords to the nearest partner
-    // in each quarter of the tangent plane of the first normal (about +t1, +t2, -t1, -t2): the
-    // normal is the mean of the normals of the four triangles that consecutive chords span,
-    // each turned to the first normal's side (a vertex normal). Beside an edge the nearest partner across it is the edge
-    // node, which lies in the face's plane, so the row next to an edge gets its face's normal,
-    // where the first normal leans towards the other face. At an edge or a corner the triangles'
-    // normals are those of the faces that meet there and their mean bisects them; 3D has no
-    // corner condition (corners stay 0).
-    std::vector<Vec<Dim>>& improved = work.improved;
-    improved.resize(static_cast<std::size_t>(count));
-    exec::particle_for(policy, count, [&](Index k) {
-      const Index i = which != nullptr ? which[k] : k;
-      const auto iu = static_cast<std::size_t>(i);
-      improved[static_cast<std::size_t>(k)] = normals[iu];
-      if (flags[iu] == 0) return;
-      const Vec<Dim> n0 = normals[iu];
-      // A tangent frame: t1 normal to n0 and to the axis least aligned with it.
-      int axis = 0;
-      for (int d = 1; d < 3; ++d) axis = std::abs(n0[d]) < std::abs(n0[axis]) ? d : axis;
-      const Vec<Dim> t1 = n0.cross(Vec<Dim>::Unit(axis)).normalized();
-      const Vec<Dim> t2 = n0.cross(t1);
-      double best[4] = {r2, r2, r2, r2};
-      Vec<Dim> chord[4] = {Vec<Dim>::Zero(), Vec<Dim>::Zero(), Vec<Dim>::Zero(), Vec<Dim>::Zero()};
-      for (const Index j : relation.row(i)) {
-        const auto ju = static_cast<std::size_t>(j);
-        if (j == i || set.volume[ju] == 0.0) continue;
-        const bool partner =
-            flags[ju] != 0 || (!excluded.empty() && excluded[ju] != 0 && lambda[ju] <= options.interior_above);
-        if (!partner) continue;
-        const Vec<Dim> c = set.position[ju] - set.position[iu];
-        const double a = t1.dot(c), b = t2.dot(c);
-        if (a == 0.0 && b == 0.0) continue;
-        const int quarter = std::abs(a) >= std::abs(b) ? (a > 0.0 ? 0 : 2) : (b > 0.0 ? 1 : 3);
-        const double d2 = c.squaredNorm();
-        if (d2 < best[quarter]) {
-          best[quarter] = d2;
-          chord[quarter] = c;
+        Vec<Dim> p[2];
+        int found = 0;
+        for (int side = 0; side < 2; ++side) {
+          if (chord[side].squaredNorm() == 0.0) continue;
+          Vec<Dim> q(-chord[side][1], chord[side][0]);
+          if (q.dot(n0) < 0.0) q = -q;
+          p[found++] = q.normalized();
         }
+        if (found == 0) return;
+        const Vec<Dim> sum = found == 2 ? Vec<Dim>(p[0] + p[1]) : p[0];
+        if (sum.norm() > 0.0) improved[static_cast<std::size_t>(k)] = sum / sum.norm();
+        if (found == 2 && corners != nullptr && p[0].dot(p[1]) < corner_cos) (*corners)[iu] = 1;
+      } else {
+        if (n0.squaredNorm() == 0.0) return;
+        // A tangent frame: t1 normal to n0 and to the axis least aligned with it.
+        int axis = 0;
+        for (int d = 1; d < 3; ++d) axis = std::abs(n0[d]) < std::abs(n0[axis]) ? d : axis;
+        const Vec<Dim> t1 = n0.cross(Vec<Dim>::Unit(axis)).normalized();
+        const Vec<Dim> t2 = n0.cross(t1);
+        double best[4] = {r2, r2, r2, r2};
+        Vec<Dim> chord[4] = {Vec<Dim>::Zero(), Vec<Dim>::Zero(), Vec<Dim>::Zero(), Vec<Dim>::Zero()};
+        for (const Index j : relation.row(i)) {
+          if (!partner(i, j)) continue;
+          const Vec<Dim> c = set.position[static_cast<std::size_t>(j)] - set.position[iu];
+          const double a = t1.dot(c), b = t2.dot(c);
+          if (a == 0.0 && b == 0.0) continue;
+          const int quarter = std::abs(a) >= std::abs(b) ? (a > 0.0 ? 0 : 2) : (b > 0.0 ? 1 : 3);
+          const double d2 = c.squaredNorm();
+          if (d2 < best[quarter]) {
+            best[quarter] = d2;
+            chord[quarter] = c;
+          }
+        }
+        Vec<Dim> sum = Vec<Dim>::Zero();
+        for (int q = 0; q < 4; ++q) {
+          const Vec<Dim>& a = chord[q];
+          const Vec<Dim>& b = chord[(q + 1) % 4];
+          if (a.squaredNorm() == 0.0 || b.squaredNorm() == 0.0) continue;
+          Vec<Dim> m = a.cross(b);
+          if (m.squaredNorm() == 0.0) continue;
+          if (m.dot(n0) < 0.0) m = -m;
+          sum += m.normalized();
+        }
+        if (sum.norm() > 0.0) improved[static_cast<std::size_t>(k)] = sum / sum.norm();
       }
-      Vec<Dim> sum = Vec<Dim>::Zero();
-      for (int q = 0; q < 4; ++q) {
-        const Vec<Dim>& a = chord[q];
-        const Vec<Dim>& b = chord[(q + 1) % 4];
-        if (a.squaredNorm() == 0.0 || b.squaredNorm() == 0.0) continue;
-        Vec<Dim> m = a.cross(b);
-        if (m.squaredNorm() == 0.0) continue;
-        if (m.dot(n0) < 0.0) m = -m;
-        sum += m.normalized();
-      }
-      if (sum.norm() > 0.0) improved[static_cast<std::size_t>(k)] = sum / sum.norm();
     });
     for (Index k = 0; k < count; ++k) {
       const auto iu = static_cast<std::size_t>(which != nullptr ? which[k] : k);
