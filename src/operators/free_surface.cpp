@@ -212,7 +212,7 @@ void detect_free_surface(const ParticleSet<Dim>& set, const Relation<Dim>& relat
                          const std::vector<std::uint8_t>& previous, const std::vector<std::uint8_t>& excluded,
                          std::vector<std::uint8_t>& flags, std::vector<Vec<Dim>>& normals, const exec::Threads& policy,
                          std::vector<std::uint8_t>* corners, FreeSurfaceScratch<Dim>* scratch,
-                         const DetectionMirrors<Dim>* mirrors) {
+                         const DetectionMirrors<Dim>* mirrors, std::vector<Vec<Dim>>* edges) {
   FreeSurfaceScratch<Dim> local;
   FreeSurfaceScratch<Dim>& work = scratch != nullptr ? *scratch : local;
   const Index n = set.size();
@@ -392,14 +392,23 @@ void detect_free_surface(const ParticleSet<Dim>& set, const Relation<Dim>& relat
       for (Index k = 0; k < count; ++k) (*corners)[static_cast<std::size_t>(which[k])] = 0;
     }
   }
+  if (edges != nullptr) {
+    if (full || edges->size() != nu) {
+      edges->assign(nu, Vec<Dim>::Zero());
+    } else {
+      for (Index k = 0; k < count; ++k) (*edges)[static_cast<std::size_t>(which[k])].setZero();
+    }
+  }
   // Step 4 in 3D (method-notes eq. (3.6.6)): the same from the chords to the nearest partner in
   // each quarter of the tangent plane of the first normal (about +t1, +t2, -t1, -t2): the normal
   // is the mean of the normals of the four triangles that consecutive chords span, each turned to
   // the first normal's side (a vertex normal). Beside an edge the nearest partner across it is the
   // edge node, which lies in the face's plane, so the row next to an edge gets its face's normal,
-  // where the first normal leans towards the other face. At an edge or a corner the triangles'
-  // normals are those of the faces that meet there and their mean bisects them; 3D has no corner
-  // condition (corners stay 0).
+  // where the first normal leans towards the other face. At an edge or a vertex the triangles'
+  // normals are those of the faces that meet there and their mean bisects them: where two of them
+  // differ by more than kCornerTurn the node is on an edge, of direction n1 x n2 for the two most
+  // different, and where a third differs by as much from both, on a vertex (a corner: three
+  // faces, method-notes eq. (3.7.4)).
   if constexpr (Dim >= 2) {
     const double corner_cos = std::cos(kCornerTurn);
     std::vector<Vec<Dim>>& improved = work.improved;
@@ -467,16 +476,35 @@ void detect_free_surface(const ParticleSet<Dim>& set, const Relation<Dim>& relat
           }
         }
         Vec<Dim> sum = Vec<Dim>::Zero();
+        Vec<Dim> m[4];
+        int found = 0;
         for (int q = 0; q < 4; ++q) {
           const Vec<Dim>& a = chord[q];
           const Vec<Dim>& b = chord[(q + 1) % 4];
           if (a.squaredNorm() == 0.0 || b.squaredNorm() == 0.0) continue;
-          Vec<Dim> m = a.cross(b);
-          if (m.squaredNorm() == 0.0) continue;
-          if (m.dot(n0) < 0.0) m = -m;
-          sum += m.normalized();
+          Vec<Dim> mq = a.cross(b);
+          if (mq.squaredNorm() == 0.0) continue;
+          if (mq.dot(n0) < 0.0) mq = -mq;
+          m[found] = mq.normalized();
+          sum += m[found++];
         }
         if (sum.norm() > 0.0) improved[static_cast<std::size_t>(k)] = sum / sum.norm();
+        // The two most different triangle normals: an edge if they turn by more than kCornerTurn.
+        int p = 0, q = 0;
+        double lowest = 1.0;
+        for (int a = 0; a < found; ++a) {
+          for (int b = a + 1; b < found; ++b) {
+            if (m[a].dot(m[b]) < lowest) lowest = m[a].dot(m[b]), p = a, q = b;
+          }
+        }
+        if (lowest >= corner_cos) return;
+        bool vertex = false;
+        for (int c = 0; c < found; ++c) vertex = vertex || (m[c].dot(m[p]) < corner_cos && m[c].dot(m[q]) < corner_cos);
+        if (vertex) {
+          if (corners != nullptr) (*corners)[iu] = 1;
+        } else if (edges != nullptr) {
+          (*edges)[iu] = m[p].cross(m[q]).normalized();
+        }
       }
     });
     for (Index k = 0; k < count; ++k) {
@@ -488,13 +516,34 @@ void detect_free_surface(const ParticleSet<Dim>& set, const Relation<Dim>& relat
 
 template <int Dim>
 void make_corner_traction_free(double* s) {
-  // Two traction-free faces through the point: sigma n1 = sigma n2 = 0 with n1, n2 independent
-  // leaves no in-plane stress (the out-of-plane sigma_zz is kept, as for a face).
+  // 2D: two traction-free faces through the point, sigma n1 = sigma n2 = 0 with n1, n2
+  // independent, leave no in-plane stress (the out-of-plane sigma_zz is kept, as for a face).
+  // 3D: three independent faces (a vertex) leave no stress at all.
   if constexpr (Dim == 2) {
     s[stress_slot<Dim>(0, 0)] = 0.0;
     s[stress_slot<Dim>(1, 1)] = 0.0;
     s[stress_slot<Dim>(0, 1)] = 0.0;
+  } else if constexpr (Dim == 3) {
+    for (int c = 0; c < kStressComponents<Dim>; ++c) s[c] = 0.0;
   } else {
+    static_cast<void>(s);
+  }
+}
+
+template <int Dim>
+void make_edge_traction_free(const Vec<Dim>& e, double* s) {
+  // sigma n1 = sigma n2 = 0 for the two faces through the edge leaves sigma = (e.sigma e) e (x) e.
+  if constexpr (Dim == 3) {
+    Mat<Dim> S;
+    for (int k = 0; k < Dim; ++k) {
+      for (int d = 0; d < Dim; ++d) S(k, d) = s[stress_slot<Dim>(k, d)];
+    }
+    const double see = e.dot(S * e);
+    for (int k = 0; k < Dim; ++k) {
+      for (int d = k; d < Dim; ++d) s[stress_slot<Dim>(k, d)] = see * e[k] * e[d];
+    }
+  } else {
+    static_cast<void>(e);
     static_cast<void>(s);
   }
 }
@@ -518,14 +567,15 @@ void make_traction_free(const Vec<Dim>& n, double* s) {
   }
 }
 
-#define RKTSPH_INSTANTIATE(D)                                                                                  \
-  template void detect_free_surface<D>(const ParticleSet<D>&, const Relation<D>&, const CubicSplineKernel<D>&, \
-                                       const FreeSurfaceOptions&, const std::vector<std::uint8_t>&,            \
-                                       const std::vector<std::uint8_t>&, std::vector<std::uint8_t>&,           \
-                                       std::vector<Vec<D>>&, const exec::Threads&, std::vector<std::uint8_t>*, \
-                                       FreeSurfaceScratch<D>*, const DetectionMirrors<D>*);                    \
-  template void make_traction_free<D>(const Vec<D>&, double*);                                                 \
-  template void make_corner_traction_free<D>(double*);
+#define RKTSPH_INSTANTIATE(D)                                                                                     \
+  template void detect_free_surface<D>(const ParticleSet<D>&, const Relation<D>&, const CubicSplineKernel<D>&,    \
+                                       const FreeSurfaceOptions&, const std::vector<std::uint8_t>&,               \
+                                       const std::vector<std::uint8_t>&, std::vector<std::uint8_t>&,              \
+                                       std::vector<Vec<D>>&, const exec::Threads&, std::vector<std::uint8_t>*,    \
+                                       FreeSurfaceScratch<D>*, const DetectionMirrors<D>*, std::vector<Vec<D>>*); \
+  template void make_traction_free<D>(const Vec<D>&, double*);                                                    \
+  template void make_corner_traction_free<D>(double*);                                                            \
+  template void make_edge_traction_free<D>(const Vec<D>&, double*);
 RKTSPH_INSTANTIATE(1)
 RKTSPH_INSTANTIATE(2)
 RKTSPH_INSTANTIATE(3)

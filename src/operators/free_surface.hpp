@@ -10,7 +10,8 @@
 //   4. 2D: the improved normal, from the perpendiculars to the chords to the two adjacent surface
 //      nodes (one on either side); a corner where those two differ by more than kCornerTurn;
 //      3D: from the triangles that the chords to the nearest partner in each quarter of the
-//      tangent plane span (method-notes eq. (3.6.6)), no corners;
+//      tangent plane span (method-notes eq. (3.6.6)); an edge where two of their normals differ by
+//      more than kCornerTurn, a vertex (corner) where a third differs from both;
 //   5. temporal coherence: a node that was not on the surface may become one only next to a
 //      node that was, or with lambda_I <= surface_below (a genuinely new surface);
 //   6. nodes excluded by the caller (explicit boundary conditions) are never flagged;
@@ -102,7 +103,9 @@ Vec<Dim> reflect(const MirrorPlaneAt<Dim>& plane, const Vec<Dim>& x) {
 /// `relation` (the set's own neighbours within the support; a wider Verlet list is cut back).
 /// `previous` (may be empty) holds the flags of the last step for the temporal coherence;
 /// `excluded` (may be empty) the particles never flagged. Normals are zero off the surface.
-/// `corners`, if given, gets 1 at the surface nodes where two faces meet (2D; see step 4).
+/// `corners`, if given, gets 1 at the surface nodes where faces meet with no single normal (2D:
+/// two faces; 3D: three, a vertex; see step 4). `edges`, if given (3D), gets at a node where two
+/// faces meet along a line the unit direction of that edge, zero elsewhere.
 /// `mirrors`, if given, the planes whose images each node sums in steps 1-3 (step 7): a node
 /// with images is never settled (its images move with the bodies, not with the nodes).
 template <int Dim>
@@ -111,7 +114,8 @@ void detect_free_surface(const ParticleSet<Dim>& set, const Relation<Dim>& relat
                          const std::vector<std::uint8_t>& previous, const std::vector<std::uint8_t>& excluded,
                          std::vector<std::uint8_t>& flags, std::vector<Vec<Dim>>& normals,
                          const exec::Threads& policy = {}, std::vector<std::uint8_t>* corners = nullptr,
-                         FreeSurfaceScratch<Dim>* scratch = nullptr, const DetectionMirrors<Dim>* mirrors = nullptr);
+                         FreeSurfaceScratch<Dim>* scratch = nullptr, const DetectionMirrors<Dim>* mirrors = nullptr,
+                         std::vector<Vec<Dim>>* edges = nullptr);
 
 /// Traction-free stress by rotation to the local frame (method-notes §3.7): sigma.n = 0 with the
 /// tangential stress kept, sigma <- sigma - (sigma n) (x) n - n (x) (sigma n) + (n.sigma n) n (x) n;
@@ -119,17 +123,33 @@ void detect_free_surface(const ParticleSet<Dim>& set, const Relation<Dim>& relat
 template <int Dim>
 void make_traction_free(const Vec<Dim>& n, double* stress);
 
-/// Traction-free on two faces through a corner (2D): no in-plane stress, sigma_zz kept.
+/// Traction-free on the faces through a corner: 2D, two faces, no in-plane stress (sigma_zz
+/// kept); 3D, three independent faces (a vertex), no stress at all.
 template <int Dim>
 void make_corner_traction_free(double* stress);
 
-/// The surface condition of a node: the corner's, or the face's about n.
+/// Traction-free on the two faces through an edge of direction e (3D, |e| = 1, method-notes
+/// eq. (3.7.4)): sigma n1 = sigma n2 = 0 leaves only the stress along the edge,
+/// sigma <- (e . sigma e) e (x) e.
 template <int Dim>
-void make_surface_traction_free(const Vec<Dim>& n, bool corner, double* stress) {
+void make_edge_traction_free(const Vec<Dim>& e, double* stress);
+
+/// The surface condition of a node: the corner's, the edge's along `edge` (3D, nonzero there),
+/// or the face's about n.
+template <int Dim>
+void make_surface_traction_free(const Vec<Dim>& n, bool corner, const Vec<Dim>& edge, double* stress) {
   if (corner)
     make_corner_traction_free<Dim>(stress);
+  else if (edge.squaredNorm() > 0.0)
+    make_edge_traction_free<Dim>(edge, stress);
   else
     make_traction_free<Dim>(n, stress);
+}
+
+/// The same where no node is on an edge (2D, V1's polygon faces).
+template <int Dim>
+void make_surface_traction_free(const Vec<Dim>& n, bool corner, double* stress) {
+  make_surface_traction_free<Dim>(n, corner, Vec<Dim>::Zero(), stress);
 }
 
 }  // namespace rktsph

@@ -89,7 +89,8 @@ class StaggeredModel {
   struct SurfaceRows {
     std::vector<Index> row;
     std::vector<Vec<Dim>> normal;
-    std::vector<std::uint8_t> corner;  // 1: two faces meet there (method-notes §3.6)
+    std::vector<std::uint8_t> corner;  // 1: faces meet there with no single normal (method-notes §3.6)
+    std::vector<Vec<Dim>> edge;        // 3D: the direction of the edge the row is on, else zero; may be empty
     DifferenceGradient<Dim> gradient;
     /// Polygon edges with a prescribed traction (V1, method-notes §3.9): per row (normal,
     /// tangential) in Pa and its time function; empty where every row is traction-free.

@@ -340,7 +340,7 @@ namespace {
 
 // The stress gradient at a detected free-surface node (V2): sigma = P(sigma) + Q(sigma), with P
 // the traction-free projection of method-notes §3.7 about the node's normal (at a corner: no
-// in-plane stress) and Q = 1 - P the
+// in-plane stress; on a 3D edge: the stress along it alone) and Q = 1 - P the
 // part that the condition prescribes (zero). As fix (a) of §0.3 item 1 does for a prescribed
 // component, Q enters through the difference form with fhat = 0, P through the corrected
 // gradient: grad sigma = P(grad_corrected sigma) + Q(sum_b c_b sigma_b).
@@ -361,14 +361,15 @@ void surface_stress_gradient(const typename StaggeredModel<Dim>::SurfaceRows& su
   }
   const Vec<Dim>& n = surface.normal[r];
   const bool corner = surface.corner[r] != 0;
+  const Vec<Dim> edge = surface.edge.empty() ? Vec<Dim>::Zero() : surface.edge[r];
   for (int d = 0; d < Dim; ++d) {
     double p[NS], q[NS];
     for (int c = 0; c < NS; ++c) {
       p[c] = grad_s[d][c];
       q[c] = sum[d][c];
     }
-    make_surface_traction_free<Dim>(n, corner, p);
-    make_surface_traction_free<Dim>(n, corner, q);  // P(sum); Q(sum) = sum - P(sum)
+    make_surface_traction_free<Dim>(n, corner, edge, p);
+    make_surface_traction_free<Dim>(n, corner, edge, q);  // P(sum); Q(sum) = sum - P(sum)
     for (int c = 0; c < NS; ++c) grad_s[d][c] = p[c] + (sum[d][c] - q[c]);
   }
 }

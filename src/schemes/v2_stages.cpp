@@ -294,7 +294,7 @@ void DetectFreeSurface<Dim>::run(const StepContext&) {
     mirrors = &mirrors_;
   }
   detect_free_surface<Dim>(m_.nodes, rebuild_.node_neighbours(), m_.kernel, options, previous_, excluded_, flags_,
-                           normals_, m_.policy, &corners_, &scratch_, mirrors);
+                           normals_, m_.policy, &corners_, &scratch_, mirrors, Dim == 3 ? &edges_ : nullptr);
   unflagged_by_bodies_ = 0;
   if constexpr (Dim == 2) {
     // Next to a body the support is cut by it, not by a free surface: a flag whose normal
@@ -337,11 +337,13 @@ void DetectFreeSurface<Dim>::run(const StepContext&) {
   rows.row.assign(nn, -1);
   rows.normal.clear();
   rows.corner.clear();
+  rows.edge.clear();
   for (std::size_t k = 0; k < surface_.size(); ++k) {
     const auto i = static_cast<std::size_t>(surface_[k]);
     rows.row[i] = static_cast<Index>(k);
     rows.normal.push_back(normals_[i]);
     rows.corner.push_back(corners_[i]);
+    if (!edges_.empty()) rows.edge.push_back(edges_[i]);  // 3D only
   }
   build_difference_gradient_rows<Dim>(rebuild_.stress_points_of_nodes(), m_.nodes.position, surface_, m_.stress_points,
                                       m_.kernel, rows.gradient);
@@ -456,6 +458,7 @@ void DetectFreeSurface<Dim>::load(const io::StateArchive& a, const std::string& 
   // A partial pass rewrites the flags and normals of the active nodes only: the others are 0.
   flags_.assign(scratch_.settled.size(), 0);
   normals_.assign(scratch_.settled.size(), Vec<Dim>::Zero());
+  if constexpr (Dim == 3) edges_.assign(scratch_.settled.size(), Vec<Dim>::Zero());
 }
 
 template <int Dim>
@@ -466,7 +469,7 @@ void DetectFreeSurface<Dim>::reordered(const Reordering& r) {
   for (const Index i : m_.constraints.constrained()) fixed_excluded_[static_cast<std::size_t>(i)] = 1;
   permute_rows(excluded_, r.nodes);  // it keeps the deactivated nodes
   permute_rows(corners_, r.nodes);   // node shifting reads them before the next detection
-  // flags_, normals_ and surface_ are not read before the next detection rewrites them (the
+  // flags_, normals_, edges_ and surface_ are not read before the next detection rewrites them (the
   // sort runs before it in the step; a resume detects before the step's end needs them), which
   // is a full pass: the settled interior is forgotten.
   scratch_.settled.clear();
@@ -477,7 +480,8 @@ void DetectFreeSurface<Dim>::reapply_traction_free() {
   auto stress = m_.nodes.view(m_.fields.stress);
   for (const Index i : surface_) {
     const auto iu = static_cast<std::size_t>(i);
-    rktsph::make_surface_traction_free<Dim>(normals_[iu], corners_[iu] != 0, stress[i]);
+    rktsph::make_surface_traction_free<Dim>(normals_[iu], corners_[iu] != 0,
+                                            edges_.empty() ? Vec<Dim>::Zero() : edges_[iu], stress[i]);
   }
 }
 

@@ -130,7 +130,7 @@ class DetectFreeSurface final : public Stage {
   void run(const StepContext& context) override;
   std::size_t scratch_bytes() const override {
     return previous_.capacity() + flags_.capacity() + excluded_.capacity() + corners_.capacity() +
-           normals_.capacity() * sizeof(Vec<Dim>) + scratch_.bytes() + mirrors_.bytes();
+           (normals_.capacity() + edges_.capacity()) * sizeof(Vec<Dim>) + scratch_.bytes() + mirrors_.bytes();
   }
   void save(io::StateArchive& archive, const std::string& prefix) const override;
   void load(const io::StateArchive& archive, const std::string& prefix) override;
@@ -158,6 +158,7 @@ class DetectFreeSurface final : public Stage {
   Field<double, 1> flag_field_;
   Field<double, Dim> normal_field_;
   std::vector<std::uint8_t> previous_, flags_, excluded_, fixed_excluded_, corners_;
+  std::vector<Vec<Dim>> edges_;  // 3D: each surface node's edge direction, zero off an edge
   const RigidContact* contact_ = nullptr;
   Index unflagged_by_bodies_ = 0;
   /// The mirror planes of the last detection (solver.surface_mirrors) and how many nodes had any.
