@@ -118,8 +118,9 @@ template <int Dim>
 io::ScalarField probe_field(const ProbeSpec& spec, const std::string& field, const io::FieldCatalogue<Dim>& nodes) {
   auto value = nodes.scalar(field);
   if (!value) {
-    throw InputError(fmt::format("{}, key 'probe.fields': unknown field '{}' for probe '{}' (available: {})",
-                                 spec.where, field, spec.name, fmt::join(nodes.scalar_names(), ", ")));
+    throw InputError(fmt::format("{}: unknown field '{}' for probe '{}' (available: {})",
+                                 spec.fields_where.empty() ? spec.where : spec.fields_where, field, spec.name,
+                                 fmt::join(nodes.scalar_names(), ", ")));
   }
   return std::move(*value);
 }

@@ -187,6 +187,7 @@ ProbeSpec read_probe(const io::Section& p, const CaseSetup<Dim>& c) {
   if (static_cast<int>(spec.position.size()) != Dim) {
     p.fail("position", fmt::format("must have {} coordinate{} for a {}D case", Dim, Dim > 1 ? "s" : "", Dim));
   }
+  spec.fields_where = p.where("fields");
   spec.fields = p.strings("fields");
   p.require(!spec.fields.empty(), "fields", "must name at least one field");
   for (const auto& other : c.probes) {

@@ -158,7 +158,8 @@ struct FluidSpec {
 
 struct ProbeSpec {
   std::string name;
-  std::string where;
+  std::string where;         // the position's place in the case file, for its messages
+  std::string fields_where;  // the fields' place, for an unknown field
   std::vector<double> position;
   std::vector<std::string> fields;
 };

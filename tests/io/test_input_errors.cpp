@@ -465,11 +465,14 @@ TEST(InputErrors, ProbeOutsideTheBody) {
   expect_error_at(o, line_of(text, "position = "), "probe[0].position", {"outside", "corner"});
 }
 
+// The message names the line and key of the fields (it named the position's line and a second,
+// undotted key before).
 TEST(InputErrors, UnknownProbeField) {
   test::TempDir dir;
   const std::string text = replace(kBase, "fields = [\"vx\", \"syy\"]", "fields = [\"vx\", \"velocity\"]");
   const auto o = run_case_text(dir, text);
-  expect_error_at(o, line_of(text, "position = "), "probe.fields", {"velocity", "available", "sxy"});
+  expect_error_at(o, line_of(text, "fields = "), "probe[0].fields", {"velocity", "available", "sxy"});
+  EXPECT_EQ(o.err.find("probe[0].position"), std::string::npos) << o.err;
 }
 
 TEST(InputErrors, CourantNumberAboveLimit) {
