@@ -7,7 +7,9 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -15,6 +17,7 @@
 
 #include "case/case_builder.hpp"
 #include "linear_solvers/pore_pressure.hpp"
+#include "materials/perzyna_models.hpp"
 #include "operators/corrected_operator.hpp"
 #include "particles/reseed.hpp"
 #include "schemes/pressure_stage.hpp"
@@ -462,5 +465,119 @@ void BM_V1Setup(benchmark::State& state) {
 BENCHMARK(BM_V1Setup)->Arg(100000)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 }  // namespace
+
+
+// ---- plasticity at any stiffness (method-notes §2.5)
+
+// The elastic step of the plastic block below, node-steps/s by scheme (0: V1, 1: V2), for the
+// ratio counter: BM_PlasticBlock with model 0 (elastic) runs first for each scheme.
+double g_elastic_rate[2] = {0.0, 0.0};
+
+// A square 2D block of about `nodes` nodes in homogeneous plastic flow: pure shear
+// v = eps_dot (x, -y) about the centre (eps_dot = 1 1/s), from a uniform stress already beyond
+// the surface (p' = 100 kPa, q = 400 kPa), no boundary conditions: until the free faces' waves
+// arrive (about 300 steps at the centre) every stress point and node flows at every step.
+// Models: 0 elastic, 1 Drucker–Prager (phi = 30 deg, psi = 0, cohesion c), 2 modified Cam-Clay
+// (M = 1.2, p_c0 = 200 kPa; c unused). The fluidity from the table below, the last "inf".
+CaseSetup<2> plastic_block_case(long nodes, int model, int fluidity_index, double cohesion, int scheme) {
+  static constexpr double kFluidities[5] = {1.0, 1e2, 1e4, 1e6, std::numeric_limits<double>::infinity()};
+  const double gamma = kFluidities[fluidity_index];
+  const long side = static_cast<long>(std::lround(std::sqrt(static_cast<double>(nodes)))) - 1;
+  const double dx = 0.1, length = static_cast<double>(side) * dx;
+  const ElasticConstants el = ElasticConstants::from_E_nu(2.0e7, 0.3, 2000.0);
+  CaseBuilder<2> b(fmt::format("plastic block, {} nodes, model {}, gamma {}, c {}", nodes, model, gamma, cohesion));
+  b.spacing(dx).block(Vec<2>(0.0, 0.0), Vec<2>(length, length));
+  if (model == 0) {
+    b.elastic(el.E, el.nu, el.density);
+  } else if (model == 1) {
+    DruckerPragerParameters p;
+    p.elastic = el;
+    p.cohesion = cohesion;
+    p.friction_angle = 30.0 * std::acos(-1.0) / 180.0;
+    p.fluidity = gamma;
+    b.material(make_perzyna_drucker_prager(p));
+  } else {
+    CamClayParameters p;
+    p.elastic = el;
+    p.M = 1.2;
+    p.lambda = 0.2;
+    p.kappa = 0.02;
+    p.e0 = 1.0;
+    p.p_c0 = 2.0e5;
+    p.fluidity = gamma;
+    b.material(make_perzyna_cam_clay(p));
+  }
+  // p' = 100 kPa, q = 400 kPa in plane strain: sxx - syy = 2 tau with q = sqrt(3) tau.
+  const double tau = 4.0e5 / std::sqrt(3.0);
+  b.initial_stress({-1.0e5 + tau, -1.0e5 - tau, -1.0e5, 0.0, 0.0, 0.0});
+  if (scheme == 1) b.scheme("v2").free_surface(false);
+  b.time(1.0, 0.5);
+  return b.build();
+}
+
+void BM_PlasticBlock(benchmark::State& state) {
+  omp_set_num_threads(1);
+  const int model = static_cast<int>(state.range(1)), scheme = static_cast<int>(state.range(4));
+  const double cohesion = static_cast<double>(state.range(3));
+  Simulation<2> solver(plastic_block_case(state.range(0), model, static_cast<int>(state.range(2)), cohesion, scheme));
+  // The pure-shear velocity field about the block's centre.
+  {
+    auto v = solver.mutable_node_velocity();
+    const auto& x = solver.nodes().position;
+    double cx = 0.0, cy = 0.0;
+    for (const auto& p : x) {
+      cx += p[0];
+      cy += p[1];
+    }
+    cx /= static_cast<double>(x.size());
+    cy /= static_cast<double>(x.size());
+    for (std::size_t i = 0; i < x.size(); ++i) {
+      v(static_cast<Index>(i), 0) = x[i][0] - cx;
+      v(static_cast<Index>(i), 1) = -(x[i][1] - cy);
+    }
+  }
+  for (int k = 0; k < 2; ++k) solver.step();  // past the first returns from the start beyond the surface
+  const SourceStats s0 = solver.source_stats();
+  const auto t0 = std::chrono::steady_clock::now();
+  for (auto _ : state) {
+    solver.step();
+    benchmark::ClobberMemory();
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  const SourceStats s1 = solver.source_stats();
+  const double nodes = static_cast<double>(solver.nodes().size());
+  const double steps = static_cast<double>(state.iterations());
+  const double rate = nodes * steps / seconds;
+  if (model == 0) g_elastic_rate[scheme] = rate;
+  const double points = static_cast<double>((s1.elastic_points - s0.elastic_points) + (s1.rk4_points - s0.rk4_points) +
+                                            (s1.implicit_points - s0.implicit_points));
+  state.counters["nodes"] = nodes;
+  state.counters["node_steps/s"] = benchmark::Counter(nodes * steps, benchmark::Counter::kIsRate);
+  state.counters["of_elastic"] = g_elastic_rate[scheme] > 0.0 ? rate / g_elastic_rate[scheme] : 0.0;
+  state.counters["plastic_share"] =
+      points > 0.0 ? 1.0 - static_cast<double>(s1.elastic_points - s0.elastic_points) / points : 0.0;
+  state.counters["implicit_share"] =
+      points > 0.0 ? static_cast<double>(s1.implicit_points - s0.implicit_points) / points : 0.0;
+  state.counters["newton/return"] =
+      s1.implicit_points > s0.implicit_points
+          ? static_cast<double>(s1.newton_iterations - s0.newton_iterations) /
+                static_cast<double>(s1.implicit_points - s0.implicit_points)
+          : 0.0;
+  state.counters["rk4_substeps/point"] =
+      points > 0.0 ? static_cast<double>(s1.total_substeps - s0.total_substeps) / points : 0.0;
+}
+// Arguments: nodes, model (0 elastic, 1 Drucker–Prager, 2 Cam-Clay), fluidity index (1, 1e2,
+// 1e4, 1e6 1/s, inf), cohesion in Pa (Drucker–Prager), scheme (0 V1, 1 V2). The elastic block of
+// each scheme runs first: of_elastic is the plastic rate over it.
+void plastic_block_arguments(benchmark::internal::Benchmark* b) {
+  for (int scheme : {0, 1}) {
+    b->Args({100000, 0, 0, 0, scheme});
+    for (int g = 0; g < 5; ++g) {
+      for (long c : {1L, 1000L, 100000L}) b->Args({100000, 1, g, c, scheme});
+      b->Args({100000, 2, g, 0, scheme});
+    }
+  }
+}
+BENCHMARK(BM_PlasticBlock)->Apply(plastic_block_arguments)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 BENCHMARK_MAIN();

@@ -50,6 +50,8 @@ int run_material_point(const std::string& case_file, const std::string& out_dir,
     j["path_type"] = c.path_type;
     j["steps"] = r.steps;
     j["rk4_substeps"] = r.substeps;
+    j["implicit_steps"] = r.implicit_steps;
+    j["newton_iterations"] = r.newton_iterations;
     j["max_relaxation_rate_per_s"] = r.max_relaxation_rate;
     j["final"] = {{"t", last.t}, {"p", inv.p}, {"q", inv.q}};
     for (std::size_t i = 0; i < last.state.size(); ++i) {
@@ -57,9 +59,9 @@ int run_material_point(const std::string& case_file, const std::string& out_dir,
     }
     std::ofstream(std::filesystem::path(out_dir) / "summary.json") << j.dump(2) << '\n';
     fmt::print(
-        "material point: {} along {}: {} steps, {} RK4 sub-steps; final p = {:.6g} Pa, "
+        "material point: {} along {}: {} steps, {} RK4 sub-steps, {} backward-Euler steps; final p = {:.6g} Pa, "
         "q = {:.6g} Pa\nwrote {}\n",
-        c.material->model(), c.path_type, r.steps, r.substeps, inv.p, inv.q, csv);
+        c.material->model(), c.path_type, r.steps, r.substeps, r.implicit_steps, inv.p, inv.q, csv);
     if (c.plot) {
       const std::string script = std::string(RKTSPH_SOURCE_DIR) + "/scripts/plot_material_point.py";
       const bool have_mpl = std::filesystem::exists("/usr/bin/python3") &&

@@ -485,6 +485,16 @@ int run_loop(const LoopInput& in) {
         {"bytes_operators", solver.operator_bytes()},
         {"bytes_per_node", static_cast<double>(solver.state_bytes() + solver.operator_bytes()) / nodes_count},
         {"max_source_substeps", solver.max_source_substeps()},
+        {"source",
+         {{"elastic_points", solver.source_stats().elastic_points},
+          {"rk4_points", solver.source_stats().rk4_points},
+          {"rk4_substeps", solver.source_stats().total_substeps},
+          {"max_rk4_substeps", solver.source_stats().max_substeps},
+          {"implicit_points", solver.source_stats().implicit_points},
+          {"newton_iterations", solver.source_stats().newton_iterations},
+          {"max_newton_iterations", solver.source_stats().max_newton_iterations},
+          {"max_implicit_pieces", solver.source_stats().max_implicit_pieces},
+          {"seconds", solver.source_seconds()}}},
         {"energy",
          {{"kinetic", e.kinetic},
           {"strain", e.strain - e.initial_strain},
@@ -692,6 +702,19 @@ int run_loop(const LoopInput& in) {
           "residual {:.2e}; pressure step {:.0f} % of the loop time\n",
           ps.solves, pressure->implicit_faces() ? "BiCGSTAB" : "PCG", ps.mean_iterations(), ps.max_iterations,
           ps.last_error, seconds > 0 ? 100.0 * pressure->seconds() / seconds : 0.0);
+    }
+    // The viscoplastic source: how it was integrated, and its share of the loop (method-notes
+    // §2.5); a run whose plastic cost dominates says so.
+    if (const SourceStats st = solver.source_stats(); st.total_substeps > 0 || st.implicit_points > 0) {
+      const double source_share = seconds > 0 ? 100.0 * solver.source_seconds() / seconds : 0.0;
+      std::cerr << fmt::format(
+          "viscoplastic source: {} RK4 sub-steps (at most {} a particle), {} backward-Euler returns ({:.1f} Newton "
+          "iterations each, at most {}); {:.0f} % of the loop time{}\n",
+          st.total_substeps, st.max_substeps, st.implicit_points,
+          st.implicit_points > 0 ? static_cast<double>(st.newton_iterations) / static_cast<double>(st.implicit_points)
+                                 : 0.0,
+          st.max_newton_iterations, source_share,
+          source_share > 50.0 ? " (the plastic integration dominates the run)" : "");
     }
     // V2: what rebuilding the neighbours and operators cost, the surface, the domain box.
     auto figure = [](const Stage* stage, const std::string& key) {

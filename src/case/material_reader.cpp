@@ -45,9 +45,11 @@ Overstress read_overstress(const io::Section& s) {
   return o;
 }
 
+// gamma in 1/s, or "inf": the rate-independent limit (method-notes §2.5).
 double read_fluidity(const io::Section& s) {
-  const double g = s.number("fluidity");
-  s.require(g > 0.0, "fluidity", fmt::format("the Perzyna fluidity gamma must be > 0 1/s, got {}", g));
+  const double g = s.number_or_infinity("fluidity");
+  s.require(g > 0.0, "fluidity",
+            fmt::format("the Perzyna fluidity gamma must be > 0 1/s (or \"inf\" for the rate-independent limit), got {}", g));
   return g;
 }
 

@@ -1,6 +1,7 @@
 #include "io/section.hpp"
 
 #include <cmath>
+#include <limits>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -91,6 +92,16 @@ double Section::number(std::string_view key) const {
     return *v;
   }
   fail(key, fmt::format("must be a number, got {}", type_name(n)));
+}
+
+double Section::number_or_infinity(std::string_view key) const {
+  const toml::node& n = required(key);
+  if (n.is_string()) {
+    if (n.value<std::string_view>().value() == "inf") return std::numeric_limits<double>::infinity();
+    fail(key, fmt::format("must be a number or \"inf\", got the string \"{}\"", n.value<std::string_view>().value()));
+  }
+  if (auto v = number_value(n); v && std::isinf(*v) && *v > 0.0) return *v;
+  return number(key);
 }
 
 double Section::number(std::string_view key, double fallback) const {

@@ -38,6 +38,9 @@ class Section {
   double number(std::string_view key) const;
   double number(std::string_view key, double fallback) const;
   std::optional<double> optional_number(std::string_view key) const;
+  /// A finite number, or +infinity written as TOML's `inf` or the string "inf" (a limit a model
+  /// treats apart, e.g. a rate-independent material's fluidity).
+  double number_or_infinity(std::string_view key) const;
   std::int64_t integer(std::string_view key) const;
   std::int64_t integer(std::string_view key, std::int64_t fallback) const;
   std::string string(std::string_view key) const;

@@ -61,6 +61,32 @@ struct PressureDependentModuli {
   double bulk_modulus(double p) const { return v0_over_kappa * std::clamp(p, p_min, p_max); }
   /// G for the bulk modulus K, eq. (1.8.9).
   double shear_modulus(double K) const { return constant_shear ? G_constant : G_over_K * K; }
+
+  /// p' after a plastic volumetric strain ev (positive in dilation) from p0 at fixed total strain:
+  /// dp' = K(p') ev integrated exactly, exponential within [p_min, p_max] and linear beyond
+  /// (method-notes eq. (2.5.7)); the backward-Euler return uses it so that the swelling line
+  /// ln p' = (v0/kappa) eps_vp_vol + const holds to round-off.
+  double pressure_after_plastic_volume(double p0, double ev) const {
+    double p = p0, rest = ev;
+    for (int piece = 0; piece < 3 && rest != 0.0; ++piece) {
+      if (p < p_min || (p == p_min && rest < 0.0) || p > p_max || (p == p_max && rest > 0.0)) {
+        const double edge = p <= p_min ? p_min : p_max;
+        const double slope = v0_over_kappa * edge;
+        const double to_edge = (edge - p) / slope;  // ev that reaches the clamp's edge
+        const bool reaches = (rest > 0.0 && p < p_min && rest > to_edge) || (rest < 0.0 && p > p_max && rest < to_edge);
+        if (!reaches) return p + slope * rest;
+        p = edge;
+        rest -= to_edge;
+        continue;
+      }
+      const double next = p * std::exp(v0_over_kappa * rest);
+      if (next >= p_min && next <= p_max) return next;
+      const double edge = next > p_max ? p_max : p_min;
+      rest -= std::log(edge / p) / v0_over_kappa;
+      p = edge;
+    }
+    return p;
+  }
 };
 
 /// The elastic part of the stress rate (method-notes eq. (1.2.2)):
@@ -149,8 +175,31 @@ struct SourceBatch {
 
 /// Statistics of one source integration, for the log and summary.json.
 struct SourceStats {
-  long max_substeps = 0;
-  long total_substeps = 0;
+  long elastic_points = 0;           // particles with no flow over their interval
+  long rk4_points = 0;               // particles integrated by RK4
+  long max_substeps = 0;             // RK4 sub-steps of one particle, largest
+  long total_substeps = 0;           // RK4 sub-steps, all particles
+  long implicit_points = 0;          // particles integrated by backward Euler (method-notes §2.5)
+  long newton_iterations = 0;        // their Newton iterations, all particles
+  long max_newton_iterations = 0;    // of one particle, largest (all its pieces)
+  long max_implicit_pieces = 0;      // most pieces one interval was halved into (1: none)
+
+  void add(const SourceStats& o) {
+    elastic_points += o.elastic_points;
+    rk4_points += o.rk4_points;
+    max_substeps = std::max(max_substeps, o.max_substeps);
+    total_substeps += o.total_substeps;
+    implicit_points += o.implicit_points;
+    newton_iterations += o.newton_iterations;
+    max_newton_iterations = std::max(max_newton_iterations, o.max_newton_iterations);
+    max_implicit_pieces = std::max(max_implicit_pieces, o.max_implicit_pieces);
+  }
+};
+
+/// Outcome of one backward-Euler integration of a particle's source (method-notes §2.5).
+struct ImplicitOutcome {
+  bool converged = false;
+  int iterations = 0;
 };
 
 class Material {
@@ -197,14 +246,29 @@ class Material {
   /// sub-step RK4 (method-notes §4.3). Zero when no flow occurs.
   virtual double relaxation_rate(const Sym6& sigma, const double* state) const;
 
-  /// Advance the source ODE of a batch over tau by classical RK4 (method-notes §2.2), with
-  /// automatic sub-stepping so that relaxation_rate * substep <= rk4_stability_target.
+  /// Advance the source ODE of a batch over tau (method-notes §2.2): classical RK4 with
+  /// automatic sub-stepping so that relaxation_rate * substep <= rk4_stability_target, or, for a
+  /// model that has one, backward Euler (integrate_implicit) where RK4 would need more than
+  /// max_explicit_substeps sub-steps (method-notes §2.5, eq. (2.5.6)).
   virtual SourceStats advance_source(double tau, const SourceBatch& batch) const;
+
+  /// Backward Euler of the source of one particle over tau from the trial stress (the start
+  /// stress, plus tau R with the frozen flux) and history k0 (method-notes §2.5). Models without
+  /// one return converged = false and leave sigma, k untouched.
+  virtual ImplicitOutcome integrate_implicit(const Sym6& /*sigma_trial*/, const double* /*k0*/, double /*tau*/,
+                                             Sym6& /*sigma*/, double* /*k*/) const {
+    return {};
+  }
+  virtual bool has_implicit_source() const { return false; }
 
   /// Sub-stepping target for lambda_vp * dt in one RK4 step (RK4's real-axis limit is 2.78).
   static constexpr double rk4_stability_target = 1.0;
   /// A sub-step count above this means the case is hopelessly stiff for an explicit scheme.
   static constexpr long max_substeps = 100000;
+  /// RK4 integrates a particle whose source needs at most this many sub-steps; beyond it a model
+  /// with an implicit source uses backward Euler, which costs about as much as this many RK4
+  /// sub-steps whatever the stiffness (method-notes eq. (2.5.6)).
+  static constexpr long max_explicit_substeps = 4;
 
  private:
   ElasticConstants elastic_;

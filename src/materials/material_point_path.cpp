@@ -130,6 +130,86 @@ bool finite(const Sym6& a) {
   return std::all_of(a.begin(), a.end(), [](double v) { return std::isfinite(v); });
 }
 
+/// One step of the path by backward Euler (method-notes §2.5): the elastic trial of the strain
+/// increment, returned by the model; the stress-controlled components' strain increments are
+/// found by Newton (forward differences) so that their returned stresses meet the path's.
+/// Returns the Newton iterations of the model's returns.
+long implicit_path_step(const Material& material, const LoadPath& path, double dt, Sym6& sig, Sym6& eps,
+                        std::vector<double>& k) {
+  std::vector<int> S, E;
+  for (int i = 0; i < 6; ++i) (path.control[static_cast<std::size_t>(i)] == Control::stress ? S : E).push_back(i);
+  const ElasticRate el = material.elastic_rate().at(sig.data());
+  Mat6 D = Mat6::Zero();
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) D(i, j) = el.lambda;
+  }
+  for (int i = 0; i < 6; ++i) D(i, i) += 2.0 * el.G;
+  const auto ns = static_cast<int>(S.size());
+  Eigen::Matrix<double, 6, 1> de = Eigen::Matrix<double, 6, 1>::Zero();
+  for (int i : E) de[i] = path.rate[static_cast<std::size_t>(i)] * dt;
+  // First guess of the stress-controlled increments: the elastic partition.
+  if (ns > 0) {
+    Eigen::MatrixXd Dss(ns, ns);
+    Eigen::VectorXd rhs(ns);
+    for (int a = 0; a < ns; ++a) {
+      double r = path.rate[static_cast<std::size_t>(S[a])] * dt;
+      for (int j : E) r -= D(S[a], j) * de[j];
+      rhs[a] = r;
+      for (int b = 0; b < ns; ++b) Dss(a, b) = D(S[a], S[b]);
+    }
+    const Eigen::VectorXd x = Dss.lu().solve(rhs);
+    for (int a = 0; a < ns; ++a) de[S[a]] = x[a];
+  }
+  long iterations = 0;
+  std::vector<double> k_end(k.size());
+  auto returned = [&](const Eigen::Matrix<double, 6, 1>& d, Sym6& out) {
+    const Eigen::Matrix<double, 6, 1> ds = D * d;
+    Sym6 trial;
+    for (std::size_t c = 0; c < 6; ++c) trial[c] = sig[c] + ds[static_cast<Eigen::Index>(c)];
+    const ImplicitOutcome o = material.integrate_implicit(trial, k.data(), dt, out, k_end.data());
+    iterations += o.iterations;
+    if (!o.converged) {
+      throw SolverError(fmt::format("material point: the implicit return did not converge (dt = {:.3g} s); "
+                                    "reduce path.dt",
+                                    dt));
+    }
+  };
+  Sym6 out;
+  const double scale = std::max({1.0, std::abs(sig[0]) + std::abs(sig[1]) + std::abs(sig[2]),
+                                 material.elastic().E * 1e-9});
+  for (int it = 0; it < 30; ++it) {
+    returned(de, out);
+    if (ns == 0) break;
+    Eigen::VectorXd r(ns);
+    for (int a = 0; a < ns; ++a) {
+      const auto ia = static_cast<std::size_t>(S[a]);
+      r[a] = out[ia] - (sig[ia] + path.rate[ia] * dt);
+    }
+    if (r.lpNorm<Eigen::Infinity>() <= 1e-12 * scale) break;
+    Eigen::MatrixXd J(ns, ns);
+    const std::vector<double> k_keep = k_end;
+    for (int b = 0; b < ns; ++b) {
+      Eigen::Matrix<double, 6, 1> dp = de;
+      const double h = 1e-7 * std::max(std::abs(de[S[b]]), scale / material.elastic().E);
+      dp[S[b]] += h;
+      Sym6 op;
+      returned(dp, op);
+      for (int a = 0; a < ns; ++a) J(a, b) = (op[static_cast<std::size_t>(S[a])] - out[static_cast<std::size_t>(S[a])]) / h;
+    }
+    k_end = k_keep;
+    const Eigen::VectorXd dx = J.lu().solve(-r);
+    for (int b = 0; b < ns; ++b) de[S[b]] += dx[b];
+    if (it == 29) returned(de, out);
+  }
+  // The stress-controlled components met to Newton's round-off; set to their targets so that
+  // it does not accumulate along the path.
+  for (int i : S) sig[static_cast<std::size_t>(i)] += path.rate[static_cast<std::size_t>(i)] * dt;
+  for (int i : E) sig[static_cast<std::size_t>(i)] = out[static_cast<std::size_t>(i)];
+  k = k_end;
+  for (std::size_t c = 0; c < 6; ++c) eps[c] += de[static_cast<Eigen::Index>(c)];
+  return iterations;
+}
+
 }  // namespace
 
 PathResult integrate_path(const Material& material, const Sym6& sigma0, const LoadPath& path) {
@@ -164,6 +244,17 @@ PathResult integrate_path(const Material& material, const Sym6& sigma0, const Lo
     const double lam = std::max(material.relaxation_rate(sig, k.data()), material.relaxation_rate(sst, k.data()));
     res.max_relaxation_rate = std::max(res.max_relaxation_rate, lam);
     const double want = std::ceil(lam * dt / path.relaxation_target);
+    if (material.has_implicit_source() && !(want <= static_cast<double>(Material::max_explicit_substeps))) {
+      // Stiff: backward Euler, whatever the fluidity (method-notes §2.5, eq. (2.5.6)).
+      res.newton_iterations += implicit_path_step(material, path, dt, sig, eps, k);
+      ++res.implicit_steps;
+      t = step + 1 == nsteps ? path.duration : t + dt;
+      if (!finite(sig) || !finite(eps)) {
+        throw SolverError(fmt::format("material point: non-finite stress at t = {:.6g} s", t));
+      }
+      if ((step + 1) % every == 0 || step + 1 == nsteps) record(t);
+      continue;
+    }
     if (!(want <= 1e7)) {
       throw SolverError(
           fmt::format("material point: relaxation rate {:.3g} 1/s is too stiff "

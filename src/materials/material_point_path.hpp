@@ -6,7 +6,9 @@
 //     sigma_dot = D^e : (eps_dot - eps_vp_dot(sigma, kappa)),  kappa_dot = h(sigma, kappa)
 // is solved for the unknown strain rates of the stress-controlled components from the
 // elastic partition, and integrated by classical RK4, sub-stepped against the model's
-// relaxation rate. The axial direction of the named triaxial paths is y.
+// relaxation rate; where that would take more than Material::max_explicit_substeps sub-steps,
+// a step is integrated by the model's backward Euler instead (method-notes §2.5), the
+// stress-controlled components met by Newton. The axial direction of the named triaxial paths is y.
 #include <array>
 #include <functional>
 #include <string>
@@ -53,6 +55,8 @@ struct PathResult {
   std::vector<PathPoint> points;
   long steps = 0;
   long substeps = 0;                 // total RK4 sub-steps
+  long implicit_steps = 0;           // steps integrated by backward Euler (method-notes §2.5)
+  long newton_iterations = 0;        // the Newton iterations of their returns
   double max_relaxation_rate = 0.0;  // 1/s, largest estimate met
 };
 

@@ -17,6 +17,7 @@
 
 #include "core/error.hpp"
 #include "materials/material.hpp"
+#include "materials/implicit_source.hpp"
 #include "materials/overstress.hpp"
 #include "materials/source_integrator.hpp"
 #include "materials/tension_cutoff.hpp"
@@ -70,6 +71,7 @@ class PerzynaMaterial final : public Material {
     const double x = (surface_.value(sigma, Y) - Y) / Y;
     const double slope = overstress_.slope(x);
     if (slope > 0.0) {
+      if (std::isinf(fluidity_)) return fluidity_;  // rate independent: integrated implicitly
       const Sym6 m = surface_.flow(sigma, Y);
       const Sym6 n = surface_.gradient(sigma, Y);
       const double stiff = std::abs(tensor::ddot(n, apply_elastic(sigma, m))) +
@@ -89,13 +91,26 @@ class PerzynaMaterial final : public Material {
     return lambda;
   }
 
-  /// Fast path: the RK4 batch integrator with the non-virtual rate inlined.
+  /// Fast path: the batch integrator with the non-virtual rate and return inlined (RK4 where
+  /// the source is mild, backward Euler where it is stiff: method-notes eq. (2.5.6)).
   SourceStats advance_source(double tau, const SourceBatch& batch) const override {
+    const detail::PerzynaBackwardEuler<PerzynaMaterial> implicit(*this);
     return detail::integrate_source_batch(
         tau, batch, Hardening::kSize,
         [this](const Sym6& s, const double* k, Sym6& ds, double* dk) { rate(s, k, ds, dk); },
-        [this](const Sym6& s, const double* k) { return relaxation_rate(s, k); });
+        [this](const Sym6& s, const double* k) { return relaxation_rate(s, k); },
+        [&implicit](const Sym6& trial, const double* k0, double h, Sym6& s, double* k) {
+          return implicit.solve(trial, k0, h, s, k);
+        });
   }
+
+  ImplicitOutcome integrate_implicit(const Sym6& sigma_trial, const double* k0, double tau, Sym6& sigma,
+                                     double* k) const override {
+    return detail::PerzynaBackwardEuler<PerzynaMaterial>(*this).solve(sigma_trial, k0, tau, sigma, k);
+  }
+  bool has_implicit_source() const override { return true; }
+  /// gamma = +inf: the rate-independent limit, integrated by the return mapping alone.
+  bool rate_independent() const { return std::isinf(fluidity_); }
 
   const Surface& surface() const { return surface_; }
   const Hardening& hardening() const { return hardening_; }

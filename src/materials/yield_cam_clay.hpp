@@ -15,6 +15,7 @@
 #include <numbers>
 
 #include "core/types.hpp"
+#include "materials/pq_form.hpp"
 #include "materials/tensor.hpp"
 
 namespace rktsph {
@@ -22,6 +23,9 @@ namespace rktsph {
 struct CamClaySurface {
   double M_c = 1.0;             // critical-state slope in triaxial compression
   bool lode_dependent = false;  // M(theta) instead of constant M_c
+
+  /// With M(theta) the return moves in the coaxial deviatoric plane (method-notes §2.5).
+  bool lode_depends() const { return lode_dependent; }
 
   /// Tension guard (method-notes §1.8): for p' <= kTensionGuard * p_c, F = p' (no q term).
   static constexpr double kTensionGuard = 1e-6;
@@ -91,6 +95,28 @@ struct CamClaySurface {
     for (std::size_t i = 0; i < 6; ++i) m[i] = (3.0 * s[i] + dfdM * sl.dM[i]) / Y;
     for (std::size_t i = 0; i < 3; ++i) m[i] += iso / Y;
     return m;
+  }
+
+  /// F and the flow in the (p', q) plane with constant M (method-notes eq. (2.5.8)):
+  /// Q_p = M^2 (2p' - p_c)/p_c, Q_q = 2q/p_c, the flow() above; F with its tension guard.
+  PQForm pq(double p, double q, double Y) const {
+    PQForm f;
+    const double M2 = M_c * M_c;
+    if (p <= kTensionGuard * Y) {
+      f.F = p;
+      f.F_p = 1.0;
+    } else {
+      f.F = p + q * q / (M2 * p);
+      f.F_p = 1.0 - q * q / (M2 * p * p);
+      f.F_q = 2.0 * q / (M2 * p);
+    }
+    f.Q_p = M2 * (2.0 * p - Y) / Y;
+    f.Q_q = 2.0 * q / Y;
+    f.Q_pp = 2.0 * M2 / Y;
+    f.Q_qq = 2.0 / Y;
+    f.Q_pY = -2.0 * M2 * p / (Y * Y);
+    f.Q_qY = -2.0 * q / (Y * Y);
+    return f;
   }
 
   /// sin(phi_c) -> M_c in triaxial compression (docs/cases.md §1.2 C3).

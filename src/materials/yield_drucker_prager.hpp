@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "core/types.hpp"
+#include "materials/pq_form.hpp"
 #include "materials/tensor.hpp"
 
 namespace rktsph {
@@ -49,6 +50,9 @@ struct DruckerPragerSurface {
   double round_F = 0.0;   // eps sin(phi): delta_F = round_F * Y
   double round_Q = 0.0;   // eps sin(psi): delta_Q = round_Q * Y
 
+  /// F and Q depend on p and q alone (method-notes §2.5).
+  bool lode_depends() const { return false; }
+
   /// F of eq. (1.10.1), Pa.
   double value(const Sym6& sigma, double Y) const {
     const Invariants inv = invariants(sigma);
@@ -62,6 +66,26 @@ struct DruckerPragerSurface {
   /// m = dQ/dsigma (eq. 1.10.4): its deviatoric part has sqrt(2/3 e:e) = q/sqrt(q^2 + delta_Q^2),
   /// 1 away from the apex, as for von Mises.
   Sym6 flow(const Sym6& sigma, double Y) const { return cone_gradient(sigma, Y, round_Q * Y, eta_flow); }
+
+  /// F and Q of eqs. (1.10.1), (1.10.3) in the (p', q) plane (method-notes eq. (2.5.8)). Without
+  /// rounding, Q_q is 1 on the axis too (its limit along the deviator; the apex of §2.5).
+  PQForm pq(double p, double q, double Y) const {
+    PQForm f;
+    const double dF = round_F * Y, dQ = round_Q * Y;
+    const double RF = std::sqrt(q * q + dF * dF), RQ = std::sqrt(q * q + dQ * dQ);
+    f.F = RF - eta * p;
+    f.F_p = -eta;
+    f.F_q = RF > 0.0 ? q / RF : 1.0;
+    f.F_Y = RF > 0.0 ? round_F * dF / RF : 0.0;
+    f.Q_p = -eta_flow;
+    f.Q_q = RQ > 0.0 ? q / RQ : 1.0;
+    if (RQ > 0.0) {
+      const double RQ3 = RQ * RQ * RQ;
+      f.Q_qq = dQ * dQ / RQ3;
+      f.Q_qY = -q * round_Q * dQ / RQ3;
+    }
+    return f;
+  }
 
   /// The potential Q of eq. (1.10.3), for the tests.
   double potential(const Sym6& sigma, double Y) const {

@@ -75,6 +75,9 @@ struct MohrCoulombSurface {
   double round_F = 0.0;  // eps sin(phi): delta_F = round_F * Y
   double round_Q = 0.0;  // eps sin(psi)
 
+  /// K(theta): the return moves in the coaxial deviatoric plane (method-notes §2.5).
+  bool lode_depends() const { return true; }
+
   /// theta_T in radians, in [kMinTransitionDegrees, kMaxTransitionDegrees] degrees.
   static MohrCoulombSurface make(double phi, double psi, double eps,
                                  double transition = LodeFactor::kDefaultTransition) {

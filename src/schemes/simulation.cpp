@@ -240,11 +240,20 @@ HistoryView Simulation<Dim>::stress_point_history(std::string_view name) const {
 }
 
 template <int Dim>
-long Simulation<Dim>::max_source_substeps() const {
+SourceStats Simulation<Dim>::source_stats() const {
+  // Steps 1 and 2 share one ViscoplasticSources; step 2 of any scheme owns it.
   for (const auto& stage : scheme_->stages()) {
-    if (auto* s = dynamic_cast<const NodeFullStep<Dim>*>(stage.get())) return s->sources().max_substeps();
+    if (auto* s = dynamic_cast<const SourceOwner<Dim>*>(stage.get())) return s->sources().stats();
   }
-  return 0;
+  return {};
+}
+
+template <int Dim>
+double Simulation<Dim>::source_seconds() const {
+  for (const auto& stage : scheme_->stages()) {
+    if (auto* s = dynamic_cast<const SourceOwner<Dim>*>(stage.get())) return s->sources().seconds();
+  }
+  return 0.0;
 }
 
 template class Simulation<1>;

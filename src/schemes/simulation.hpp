@@ -124,7 +124,11 @@ class Simulation {
   std::size_t pairs() const { return model_->pairs(); }
   Index operator_patterns() const { return model_->to_stress_points.patterns() + model_->to_nodes.patterns(); }
   Index degenerate_operator_rows() const { return model_->degenerate_operator_rows(); }
-  long max_source_substeps() const;
+  long max_source_substeps() const { return source_stats().max_substeps; }
+  /// Counts of the viscoplastic source's integrations so far (RK4 sub-steps, backward-Euler
+  /// particles and Newton iterations, method-notes §2.5), and the seconds spent in them.
+  SourceStats source_stats() const;
+  double source_seconds() const;
 
   /// Checkpoints: the whole state a run carries from step to step (every evolving field of
   /// both particle sets, the clock, the stages' own state), and its restoration into a

@@ -156,7 +156,8 @@ template <int Dim>
 void ViscoplasticSources<Dim>::integrate(double tau, const SourceRuns& runs, FieldView<double, NS> stress,
                                          FieldView<double, 0> history) {
   const auto stride = static_cast<std::size_t>(history.components());
-  if (run_substeps_.size() < runs.size()) run_substeps_.resize(runs.size());  // grows once per run list
+  if (run_stats_.size() < runs.size()) run_stats_.resize(runs.size());  // grows once per run list
+  const auto start = std::chrono::steady_clock::now();
   // Per run (not per particle): the runs are few and of uneven cost (sub-stepping), so threads
   // pay off from a handful of runs on.
   exec::particle_for(
@@ -176,10 +177,38 @@ void ViscoplasticSources<Dim>::integrate(double tau, const SourceRuns& runs, Fie
         batch.state_end = history[begin];
         batch.state_stride = stride;
         batch.coupling = model_.setup.coupling;
-        run_substeps_[static_cast<std::size_t>(r)] = model_.materials[m].advance_source(tau, batch).max_substeps;
+        run_stats_[static_cast<std::size_t>(r)] = model_.materials[m].advance_source(tau, batch);
       },
       exec::Schedule::dynamic);
-  for (std::size_t r = 0; r < runs.size(); ++r) max_substeps_ = std::max(max_substeps_, run_substeps_[r]);
+  for (std::size_t r = 0; r < runs.size(); ++r) stats_.add(run_stats_[r]);
+  seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+template <int Dim>
+void ViscoplasticSources<Dim>::save(io::StateArchive& a, const std::string& prefix) const {
+  a.put_integer(prefix + "max_source_substeps", stats_.max_substeps);
+  a.put_integer(prefix + "source_rk4_substeps", stats_.total_substeps);
+  a.put_integer(prefix + "source_elastic_points", stats_.elastic_points);
+  a.put_integer(prefix + "source_rk4_points", stats_.rk4_points);
+  a.put_integer(prefix + "source_implicit_points", stats_.implicit_points);
+  a.put_integer(prefix + "source_newton_iterations", stats_.newton_iterations);
+  a.put_integer(prefix + "source_max_newton_iterations", stats_.max_newton_iterations);
+  a.put_integer(prefix + "source_max_implicit_pieces", stats_.max_implicit_pieces);
+}
+
+template <int Dim>
+void ViscoplasticSources<Dim>::load(const io::StateArchive& a, const std::string& prefix) {
+  // Checkpoints written before the implicit source carry the sub-steps alone.
+  auto count = [&](const std::string& key) { return a.has(prefix + key) ? static_cast<long>(a.integer(prefix + key)) : 0L; };
+  stats_ = SourceStats{};
+  stats_.max_substeps = count("max_source_substeps");
+  stats_.total_substeps = count("source_rk4_substeps");
+  stats_.elastic_points = count("source_elastic_points");
+  stats_.rk4_points = count("source_rk4_points");
+  stats_.implicit_points = count("source_implicit_points");
+  stats_.newton_iterations = count("source_newton_iterations");
+  stats_.max_newton_iterations = count("source_max_newton_iterations");
+  stats_.max_implicit_pieces = count("source_max_implicit_pieces");
 }
 
 // ---- step 1
@@ -608,12 +637,12 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
 
 template <int Dim, class Motion, class Velocity>
 void NodeFullStep<Dim, Motion, Velocity>::save(io::StateArchive& a, const std::string& prefix) const {
-  a.put_integer(prefix + "max_source_substeps", sources_->max_substeps());
+  sources_->save(a, prefix);
 }
 
 template <int Dim, class Motion, class Velocity>
 void NodeFullStep<Dim, Motion, Velocity>::load(const io::StateArchive& a, const std::string& prefix) {
-  sources_->set_max_substeps(static_cast<long>(a.integer(prefix + "max_source_substeps")));
+  sources_->load(a, prefix);
 }
 
 // ---- checkerboard filters

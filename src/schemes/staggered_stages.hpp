@@ -36,8 +36,14 @@ class ViscoplasticSources {
   /// frozen-flux coupling).
   void integrate(double tau, const SourceRuns& runs, FieldView<double, NS> stress, FieldView<double, 0> history);
   /// The largest number of RK4 sub-steps one particle needed in one interval so far.
-  long max_substeps() const { return max_substeps_; }
-  void set_max_substeps(long n) { max_substeps_ = n; }
+  long max_substeps() const { return stats_.max_substeps; }
+  /// Every count of the integrations so far (RK4 sub-steps, backward-Euler particles and their
+  /// Newton iterations, method-notes §2.5) and the seconds spent in them.
+  const SourceStats& stats() const { return stats_; }
+  double seconds() const { return seconds_; }
+  /// Saved in checkpoints so that a resumed run reports the whole run's counts.
+  void save(io::StateArchive& archive, const std::string& prefix) const;
+  void load(const io::StateArchive& archive, const std::string& prefix);
   std::size_t bytes() const { return (sigma_start_.size() + rate_.size()) * sizeof(double); }
   /// Room for `particles` rows (grows only when a set was re-seeded larger than any before).
   void reserve(Index particles) {
@@ -51,8 +57,18 @@ class ViscoplasticSources {
  private:
   StaggeredModel<Dim>& model_;
   std::vector<double> sigma_start_, rate_;
-  std::vector<long> run_substeps_;
-  long max_substeps_ = 0;
+  std::vector<SourceStats> run_stats_;
+  SourceStats stats_;
+  double seconds_ = 0.0;
+};
+
+/// A stage that owns the viscoplastic sources of its scheme (step 2 of every instantiation), so
+/// that the run can report their counts whatever the stage's template arguments.
+template <int Dim>
+class SourceOwner {
+ public:
+  virtual ~SourceOwner() = default;
+  virtual const ViscoplasticSources<Dim>& sources() const = 0;
 };
 
 /// The pressure term of step 1 in a dry scheme: none.
@@ -96,12 +112,12 @@ class StressPointHalfStep final : public Stage {
 /// item 8). Moving particles (V2): the Jaumann rotation, the continuity equation, the
 /// positions moved with the displacement; the velocity by V1's step 2 or the simple scheme.
 template <int Dim, class Motion = FixedParticles, class Velocity = TaylorGalerkinVelocity>
-class NodeFullStep final : public Stage {
+class NodeFullStep final : public Stage, public SourceOwner<Dim> {
  public:
   NodeFullStep(StaggeredModel<Dim>& model, std::shared_ptr<ViscoplasticSources<Dim>> sources);
   std::string_view name() const override { return "nodes_full_step"; }
   void run(const StepContext& context) override;
-  const ViscoplasticSources<Dim>& sources() const { return *sources_; }
+  const ViscoplasticSources<Dim>& sources() const override { return *sources_; }
   std::size_t scratch_bytes() const override { return sources_->bytes(); }
   void save(io::StateArchive& archive, const std::string& prefix) const override;
   void load(const io::StateArchive& archive, const std::string& prefix) override;
