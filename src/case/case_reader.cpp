@@ -323,8 +323,12 @@ CaseSetup<Dim> read_case(const CaseDocument& doc) {
       c.simple_velocity = true;
     else if (velocity_update == "taylor_galerkin")
       c.simple_velocity = false;
-    else
-      s->fail("velocity_update", fmt::format("unknown value '{}' (known: simple, taylor_galerkin)", velocity_update));
+    else if (velocity_update == "hourglass") {
+      c.simple_velocity = false;
+      c.hourglass = true;
+    } else
+      s->fail("velocity_update",
+              fmt::format("unknown value '{}' (known: simple, taylor_galerkin, hourglass)", velocity_update));
     c.simple_weight = s->number("simple_weight", 1.0);
     s->require(c.simple_weight > 0.0 && c.simple_weight <= 1.0, "simple_weight",
                fmt::format("must lie in (0, 1] (the simple scheme's share of the nodal velocity update; "

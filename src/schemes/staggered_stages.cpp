@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "io/state_archive.hpp"
+#include "schemes/hourglass_control.hpp"
 #include "operators/corrected_row.hpp"
 #include "operators/run_sums.hpp"
 
@@ -462,6 +463,20 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
   const DifferenceGradient<Dim>& diff = m_.constrained_gradient;
   const bool sources = sources_->active();
   ViscoplasticSources<Dim>& src = *sources_;
+  HourglassControl<Dim>* hourglass = hourglass_.get();
+  const auto node_k = std::as_const(m_.nodes).view(m_.fields.history);
+  if (hourglass != nullptr) hourglass->reserve(nodes.size());
+  // The hourglass pass after the nodes' update, before their source (method-notes §2.6).
+  auto control_hourglass = [&] {
+    if (hourglass == nullptr) return;
+    const auto t0 = std::chrono::steady_clock::now();
+    hourglass->apply(dt, *hourglass_pairs_, node_v, node_s, sources ? src.flux_rate(0) : nullptr);
+    hourglass_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    hourglass_kinetic_ += hourglass->kinetic_change();
+    hourglass_dissipation_ += dt * hourglass->dissipation();
+    hourglass_exchange_ += dt * hourglass->exchange();
+    hourglass_theta_ = std::max(hourglass_theta_, hourglass->theta_max());
+  };
   // The update of node i from the gradients of the stress points' state and their velocity
   // interpolated back (v_half, the material velocity at t^{n+1/2}).
   auto update = [&](Index i, double(&grad_v)[Dim][Dim], double(&grad_s)[Dim][NS], double(&v_half)[Dim],
@@ -528,6 +543,8 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
     m_.materials.elastic[static_cast<std::size_t>(mat)](grad_v, node_s[i], dsig);
     double* v = node_v[i];
     double* s = node_s[i];
+    double v_n[Dim];
+    for (int d = 0; d < Dim; ++d) v_n[d] = v[d];
     if constexpr (Velocity::kSimple) {
       // The simple scheme (method-notes §2.3): from the stress points' velocity, half a step;
       // with a weight below 1, blended with V1's step 2 (eq. (2.3.2)).
@@ -546,6 +563,17 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
       // V2: the Jaumann rotation over the step with the spin of v^{n+1/2}; the density by
       // continuity; the position moved with the displacement (x - X = u).
       jaumann_rotate<Dim>(grad_v, dt, s);
+      if (hourglass != nullptr) {
+        // What the hourglass control reads (method-notes eq. (2.6.1)): x^n, v^n and the updated
+        // velocity, L, the rotated stress plus half the step's flux, G, the yield ratio.
+        double s_tilde[NS];
+        for (int k = 0; k < NS; ++k) s_tilde[k] = s[k] + 0.5 * dt * dsig[k];
+        const double* k_hist = node_k.components() > 0 ? node_k[i] : nullptr;
+        const double ratio = m_.materials[static_cast<std::size_t>(mat)].yield_ratio(to_sym6<Dim>(s_tilde), k_hist);
+        double v_simple[Dim];
+        for (int d = 0; d < Dim; ++d) v_simple[d] = damped_velocity(v_half[d], dv[d] + b[d], cd, 0.5 * dt);
+        hourglass->record(i, nodes.position[iu], v_n, v, grad_v, s_tilde, grad_s, ratio, v_simple);
+      }
       continuity_and_move<Dim>(nodes, iu, grad_v, dt, v_half);
     }
     if (sources) {
@@ -595,6 +623,7 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
       m_.to_nodes.regularised_rows = counts.regularised;
       m_.to_nodes.pair_count = counts.pairs;
       moving_->note_rows(m_.degenerate_operator_rows(), m_.regularised_operator_rows(), c.t);
+      control_hourglass();
       if (sources) src.integrate(dt, m_.node_sources, node_s, m_.nodes.view(m_.fields.history));
       return;
     }
@@ -632,7 +661,18 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
         }
       },
       exec::Schedule::even, nodes.size());
+  control_hourglass();
   if (sources) src.integrate(dt, m_.node_sources, node_s, m_.nodes.view(m_.fields.history));
+}
+
+template <int Dim, class Motion, class Velocity>
+std::vector<std::pair<std::string, double>> NodeFullStep<Dim, Motion, Velocity>::report() const {
+  if (hourglass_ == nullptr) return {};
+  return {{"hourglass_seconds", hourglass_seconds_},
+          {"hourglass_kinetic_change", hourglass_kinetic_},
+          {"hourglass_dissipation", hourglass_dissipation_},
+          {"hourglass_exchange", hourglass_exchange_},
+          {"hourglass_theta_max", hourglass_theta_}};
 }
 
 template <int Dim, class Motion, class Velocity>

@@ -18,6 +18,9 @@
 
 namespace rktsph {
 
+template <int Dim>
+class HourglassControl;
+
 /// Runge–Kutta integration of the materials' viscoplastic source over an interval (method-notes
 /// §2.2), shared by steps 1 and 2: each step records the start stress and the flux rate of its
 /// particles here, then integrates.
@@ -129,12 +132,26 @@ class NodeFullStep final : public Stage, public SourceOwner<Dim> {
   /// Moving particles: as StressPointHalfStep::set_moving_operators, on the stress points'
   /// geometry of t^n that step 1 kept.
   void set_moving_operators(MovingOperators<Dim>* moving) { moving_ = moving; }
+  /// V2's hourglass control (method-notes §2.6) over the nodes' own Verlet pairs, applied after
+  /// the nodes' update and before the source is integrated.
+  void set_hourglass(std::shared_ptr<HourglassControl<Dim>> control, const Relation<Dim>* pairs) {
+    hourglass_ = std::move(control);
+    hourglass_pairs_ = pairs;
+  }
+  const HourglassControl<Dim>* hourglass() const { return hourglass_.get(); }
+  std::vector<std::pair<std::string, double>> report() const override;
 
  private:
   StaggeredModel<Dim>& m_;
   std::shared_ptr<ViscoplasticSources<Dim>> sources_;
   double* volumetric_rate_ = nullptr;
   MovingOperators<Dim>* moving_ = nullptr;
+  std::shared_ptr<HourglassControl<Dim>> hourglass_;
+  const Relation<Dim>* hourglass_pairs_ = nullptr;
+  // The hourglass control's figures over the run: seconds, energy removed from the nodal
+  // velocity (kinetic change, J), its pure dissipation and exchange, the largest decay factor.
+  double hourglass_seconds_ = 0.0, hourglass_kinetic_ = 0.0, hourglass_dissipation_ = 0.0, hourglass_exchange_ = 0.0,
+         hourglass_theta_ = 0.0;
 };
 
 /// The prescribed components at t^{n+1} (method-notes §4.1).

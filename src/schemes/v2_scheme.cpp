@@ -20,6 +20,7 @@
 #include <utility>
 
 #include "schemes/deactivate_stage.hpp"
+#include "schemes/hourglass_control.hpp"
 #include "schemes/registry.hpp"
 #include "schemes/reseed_stage.hpp"
 #include "schemes/shift_stage.hpp"
@@ -93,11 +94,14 @@ std::unique_ptr<Scheme> make_v2_scheme(StaggeredModel<Dim>& model) {
     if (model.setup.stress_filter > 0.0) add_stress_filter();
     scheme->add(std::make_unique<ApplyConstraints<Dim>>(model));
   } else {
-    scheme->add(std::make_unique<NodeFullStep<Dim, MovingParticles, TaylorGalerkinVelocity>>(model, sources))
-        .set_moving_operators(moving);
+    auto& step2 = scheme->add(std::make_unique<NodeFullStep<Dim, MovingParticles, TaylorGalerkinVelocity>>(model, sources));
+    step2.set_moving_operators(moving);
+    if (model.setup.hourglass) {
+      step2.set_hourglass(std::make_shared<HourglassControl<Dim>>(model), &rebuilt.node_neighbours());
+    }
     if (model.setup.stress_filter > 0.0) add_stress_filter();
     scheme->add(std::make_unique<ApplyConstraints<Dim>>(model));
-    if (model.setup.filter) {
+    if (model.setup.filter && !model.setup.hourglass) {
       scheme->add(std::make_unique<VelocityFilter<Dim>>(model, model.setup.filter_strength))
           .set_moving_operators(moving);
       scheme->add(std::make_unique<ApplyConstraints<Dim>>(model));

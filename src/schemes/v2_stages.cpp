@@ -103,7 +103,7 @@ void RebuildOperators<Dim>::build_relations(bool new_reference) {
   RelationOptions diff = difference_gradient_relation_options(m_.kernel);
   diff.radius += skin_;
   constrained_.build(constrained_positions_, m_.stress_points.position, diff, m_.policy);
-  if (m_.setup.detect_free_surface) {
+  if (m_.setup.detect_free_surface || m_.setup.hourglass) {
     RelationOptions own = operator_relation_options(m_.kernel);
     own.radius += skin_;
     node_neighbours_.build(m_.nodes.position, m_.nodes.position, own, m_.policy);
