@@ -6,7 +6,7 @@ add_test(NAME run_default_case
                  --out ${CMAKE_BINARY_DIR}/test-out/case01 --quiet --threads 1)
 set_tests_properties(run_default_case PROPERTIES LABELS integration)
 
-set(RKTSPH_VALIDATION_CASES 01 02 03 04 05 06 07 08 09 10 11 12 13 14 15 16 17 mandel)
+set(RKTSPH_VALIDATION_CASES 01 02 03 04 05 06 07 08 09 10 11 12 13 14 15 16 17 18 mandel)
 foreach(case_id IN LISTS RKTSPH_VALIDATION_CASES)
   add_test(NAME validate_quick_${case_id}
            COMMAND rktsph validate --quick ${case_id} --threads 1

@@ -37,7 +37,9 @@ int run_validation(const Options& opt) {
       {"11", validate_case11}, {"12", validate_case12},
       {"13", validate_case13}, {"14", validate_case14}, {"15", validate_case15}, {"16", validate_case16},
       {"17", validate_case17},
-      // Beyond the thesis (cases/examples/).
+      // Beyond the thesis: Case 18 (cases/thesis/18_granular_column_2d.toml, docs/cases.md) and
+      // Mandel's problem (cases/examples/).
+      {"18", validate_case18},
       {"mandel", validate_mandel},
   };
   fs::create_directories(opt.out_dir);

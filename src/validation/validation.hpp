@@ -90,6 +90,8 @@ CaseReport validate_case14(const Options& options, const std::string& case_dir);
 CaseReport validate_case15(const Options& options, const std::string& case_dir);
 CaseReport validate_case16(const Options& options, const std::string& case_dir);
 CaseReport validate_case17(const Options& options, const std::string& case_dir);
+/// Case 18: the collapse of a frictional column of aspect ratio 0.5 (docs/cases.md).
+CaseReport validate_case18(const Options& options, const std::string& case_dir);
 /// Mandel's problem with a force-driven rigid plate (cases/examples/mandel_2d.toml).
 CaseReport validate_mandel(const Options& options, const std::string& case_dir);
 
