@@ -287,7 +287,11 @@ void BM_V2Step(benchmark::State& state) {
   // or on every component, stored (3) or on the fly (5): what solver.stress_filter costs.
   const long operators = state.range(5);
   setup.operators_on_the_fly = operators == 0 || operators >= 4;
-  if (operators >= 2) {
+  if (operators == 6) {
+    // V2's hourglass control (method-notes §2.6) in place of the simple scheme.
+    setup.simple_velocity = false;
+    setup.hourglass = true;
+  } else if (operators >= 2) {
     setup.stress_filter = 0.5;
     setup.stress_filter_part = operators == 3 || operators == 5 ? StressFilterPart::full : StressFilterPart::mean;
   }
@@ -342,10 +346,13 @@ void BM_V2Step(benchmark::State& state) {
 // leaves) with 2 "off", 3 "auto" (sorted at the first search), 4 "always" (every search).
 // The fifth: the gradient floor on (1, V2's default) or off (0). The sixth: the operators on
 // the fly (0, V2's default) or stored (1); with the mean stress filter stored (2) or on the fly
-// (4); with the full stress filter stored (3) or on the fly (5).
+// (4); with the full stress filter stored (3) or on the fly (5); 6: on the fly with the
+// hourglass control (velocity_update = "hourglass") instead of the simple scheme.
 BENCHMARK(BM_V2Step)
     ->Args({10000, 1, 100, 1, 1, 0})
     ->Args({100000, 1, 100, 1, 1, 0})
+    ->Args({100000, 1, 100, 1, 1, 6})
+    ->Args({100000, 2, 100, 1, 1, 6})
     ->Args({100000, 1, 100, 1, 0, 0})
     ->Args({100000, 1, 100, 0, 1, 0})
     ->Args({100000, 1, 100, 2, 1, 0})

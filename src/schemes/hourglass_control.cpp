@@ -14,6 +14,7 @@ void HourglassControl<Dim>::reserve(Index nodes) {
     accel_.resize(n * Dim);
     dsigma_.resize(n * NS);
     theta_.resize(n);
+    speed_.resize(n);
   }
 }
 
@@ -28,6 +29,16 @@ void HourglassControl<Dim>::apply(double dt, const Relation<Dim>& neighbours, Fi
   const std::vector<double>& modulus = m_.materials.p_modulus;
   std::vector<double>& accel = accel_;
   std::vector<double>& dsigma = dsigma_;
+  // Each node's wave speed at its density (eq. (4.3.3)), once.
+  std::vector<double>& speed = speed_;
+  exec::particle_for(
+      m_.policy, n,
+      [&](Index i) {
+        const auto iu = static_cast<std::size_t>(i);
+        speed[iu] = std::sqrt(modulus[static_cast<std::size_t>(set.material[iu])] / set.density[iu]);
+      },
+      exec::Schedule::even, n);
+  const double inv_h = m_.kernel.inv_h(), alpha = m_.kernel.alpha();
   // Per node: the pair sums (eqs. (2.6.2)–(2.6.3)), gathered from the node's own row, so that
   // every pair is evaluated from both sides with the same operands (antisymmetric bit for bit).
   std::vector<double>& theta = theta_;
@@ -37,26 +48,24 @@ void HourglassControl<Dim>::apply(double dt, const Relation<Dim>& neighbours, Fi
         const Node& a = nodes_[iu];
         const double rho_i = set.density[iu], V_i = set.volume[iu];
         const double mass_i = rho_i * V_i;
-        const double c_i = std::sqrt(modulus[static_cast<std::size_t>(set.material[iu])] / rho_i);
+        const double c_i = speed[iu];
         double f[Dim] = {}, ds[NS] = {};
         double kappa_sum = 0.0, dissipation = 0.0, mismatch = 0.0;
         if (V_i > 0.0) {
           for (const Index j : neighbours.row(i)) {
-            if (j == i) continue;
             const auto ju = static_cast<std::size_t>(j);
-            if (!(set.volume[ju] > 0.0)) continue;
             const Node& b = nodes_[ju];
             double x[Dim], r2 = 0.0;
             for (int d = 0; d < Dim; ++d) {
               x[d] = a.x[d] - b.x[d];
               r2 += x[d] * x[d];
             }
-            if (!(r2 < r2max) || r2 == 0.0) continue;
+            // The row holds the node itself and the Verlet skin's pairs; frozen nodes have no volume.
+            if (!(r2 < r2max) || r2 == 0.0 || !(set.volume[ju] > 0.0)) continue;
             const double r = std::sqrt(r2);
-            const double dw_over_r = m_.kernel.derivative(r) / r;  // <= 0
+            const double dw_over_r = CubicSplineKernel<Dim>::scaled_derivative(r, inv_h, alpha) * inv_h;  // <= 0
             const double rho_j = set.density[ju];
-            const double c_j = std::sqrt(modulus[static_cast<std::size_t>(set.material[ju])] / rho_j);
-            const double c_bar = 0.5 * (c_i + c_j);
+            const double c_bar = 0.5 * (c_i + speed[ju]);
             const double vv = V_i * set.volume[ju];
             // The velocity mismatch along the pair (eq. (2.6.2)).
             double me = 0.0;
@@ -66,11 +75,10 @@ void HourglassControl<Dim>::apply(double dt, const Relation<Dim>& neighbours, Fi
               me += (a.v[k] - b.v[k] - 0.5 * lx) * x[k];
             }
             me /= r;
-            mismatch = std::max(mismatch, std::abs(me) / (0.5 * (c_i + c_j)));
-            // A compressive mismatch (a shock) gets a limited Riemann-type addition (eq. (2.6.4)).
-            const double shock = me < 0.0 ? kShockCoefficient * std::min(1.0, kShockLimiter * -me / c_bar) : 0.0;
-            const double kappa = 2.0 * (xi + shock) * (0.5 * (rho_i + rho_j)) * c_bar * h * vv * dw_over_r;
-            for (int d = 0; d < Dim; ++d) f[d] += kappa * me * x[d] / r;
+            mismatch = std::max(mismatch, std::abs(me) / c_bar);
+            const double kappa = 2.0 * xi * (0.5 * (rho_i + rho_j)) * c_bar * h * vv * dw_over_r;
+            const double force = kappa * me / r;
+            for (int d = 0; d < Dim; ++d) f[d] += force * x[d];
             kappa_sum -= kappa;
             dissipation += kappa * me * me;
             // The stress mismatch (eq. (2.6.3)): its mean part in full, its deviator as far as
@@ -84,15 +92,13 @@ void HourglassControl<Dim>::apply(double dt, const Relation<Dim>& neighbours, Fi
             const double mean = (sm[0] + sm[1] + sm[2]) / 3.0;
             const double keep = 1.0 - std::max(a.yield, b.yield);
             const double delta = 2.0 * zeta * c_bar * h * vv * dw_over_r;
-            for (int c = 0; c < NS; ++c) {
-              const double dev = c < 3 ? sm[c] - mean : sm[c];
-              ds[c] += delta * ((c < 3 ? mean : 0.0) + keep * dev);
-            }
+            for (int c = 0; c < 3; ++c) ds[c] += delta * (mean + keep * (sm[c] - mean));
+            for (int c = 3; c < NS; ++c) ds[c] += delta * keep * sm[c];
           }
         }
         double power = 0.0;
         // Where the velocity departs from its linear prediction at a Mach number beyond
-        // kLimiterMach (a shock), the first-order simple scheme's velocity (eq. (2.6.6)).
+        // kLimiterMach (a shock), the first-order simple scheme's velocity (eq. (2.6.4)).
         const double w = std::min(1.0, mismatch / kLimiterMach);
         for (int d = 0; d < Dim; ++d) {
           const double ad = (V_i > 0.0 ? f[d] / mass_i : 0.0) + (dt > 0.0 ? w * a.vs[d] / dt : 0.0);

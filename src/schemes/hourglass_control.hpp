@@ -95,6 +95,7 @@ class HourglassControl {
   std::vector<double> accel_;   // a_I, Dim a node
   std::vector<double> dsigma_;  // dσ_I/dt, NS a node
   std::vector<double> theta_;   // θ_I of the last pass
+  std::vector<double> speed_;   // c_I, the pass's wave speeds
   exec::ReductionScratch reduction_;
   double kinetic_change_ = 0.0, dissipation_ = 0.0, exchange_ = 0.0, theta_max_ = 0.0;
 };
