@@ -348,7 +348,9 @@ int run_loop(const LoopInput& in) {
       for (const auto& [fname, ref] : p.fields) header += fmt::format(",{}.{}", p.name, fname);
     }
     probe_csv.append(header + "\n");
-    energy_csv.append("t,kinetic,strain,external_work,damping_loss,imbalance,kinetic_stress_points\n");
+    energy_csv.append(
+        "t,kinetic,strain,external_work,damping_loss,imbalance,kinetic_stress_points,plastic_dissipation,"
+        "stabilisation_loss\n");
   }
   long probes_reorders = 0;
   auto record_probes = [&] {
@@ -373,9 +375,10 @@ int run_loop(const LoopInput& in) {
                       "reduce the time step (time.cfl = {:.3g}) or check the loads and material parameters",
                       solver.time(), solver.step_count(), solver.cfl()));
     }
-    energy_csv.append(fmt::format("{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g}\n", solver.time(), e.kinetic,
-                                  e.strain - e.initial_strain, e.external_work, e.damping_loss, e.imbalance(),
-                                  e.kinetic_stress_points));
+    energy_csv.append(fmt::format("{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g}\n",
+                                  solver.time(), e.kinetic, e.strain - e.initial_strain, e.external_work,
+                                  e.damping_loss, e.imbalance(), e.kinetic_stress_points, e.plastic_dissipation,
+                                  e.stabilisation_loss));
   };
   auto write_frame = [&] {
     // The current positions (they move in a large-deformation scheme).
@@ -500,6 +503,8 @@ int run_loop(const LoopInput& in) {
           {"strain", e.strain - e.initial_strain},
           {"external_work", e.external_work},
           {"damping_loss", e.damping_loss},
+          {"plastic_dissipation", e.plastic_dissipation},
+          {"stabilisation_loss", e.stabilisation_loss},
           {"imbalance", e.imbalance()}}},
         {"output_frames", loop.frame},
         {"checkpoints_written", loop.checkpoints},

@@ -238,11 +238,6 @@ class Material {
   /// Initial history variables for an initial stress (e.g. p_c from the OCR for Cam-Clay).
   virtual void initial_state(const Sym6& /*sigma*/, double* /*state*/) const {}
 
-  /// How close the stress is to the yield surface, in [0, 1]: 0 elastic (and far inside), 1 on
-  /// or beyond it (F/Y clipped). V2's hourglass control diffuses the deviator of a nodal stress
-  /// mode only as far as the stress is below yield (method-notes eq. (2.6.3)).
-  virtual double yield_ratio(const Sym6& /*sigma*/, const double* /*state*/) const { return 0.0; }
-
   /// False for a purely elastic model: the solver then skips the source integration.
   virtual bool has_source() const { return false; }
   /// Pointwise source rate: dsigma = -D^e : eps_vp_dot, dstate = d kappa / dt.

@@ -91,11 +91,6 @@ class PerzynaMaterial final : public Material {
     return lambda;
   }
 
-  double yield_ratio(const Sym6& sigma, const double* state) const override {
-    const double Y = hardening_.size(state);
-    return std::clamp(surface_.value(sigma, Y) / Y, 0.0, 1.0);
-  }
-
   /// Fast path: the batch integrator with the non-virtual rate and return inlined (RK4 where
   /// the source is mild, backward Euler where it is stiff: method-notes eq. (2.5.6)).
   SourceStats advance_source(double tau, const SourceBatch& batch) const override {

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "materials/tensor.hpp"
+
 namespace rktsph {
 
 template <int Dim>
@@ -12,7 +14,7 @@ void HourglassControl<Dim>::reserve(Index nodes) {
   if (nodes_.size() < n) {
     nodes_.resize(n);
     accel_.resize(n * Dim);
-    dsigma_.resize(n * NS);
+    dsigma_.resize(n);
     theta_.resize(n);
     speed_.resize(n);
   }
@@ -49,7 +51,7 @@ void HourglassControl<Dim>::apply(double dt, const Relation<Dim>& neighbours, Fi
         const double rho_i = set.density[iu], V_i = set.volume[iu];
         const double mass_i = rho_i * V_i;
         const double c_i = speed[iu];
-        double f[Dim] = {}, ds[NS] = {};
+        double f[Dim] = {}, ds = 0.0;
         double kappa_sum = 0.0, dissipation = 0.0, mismatch = 0.0;
         if (V_i > 0.0) {
           for (const Index j : neighbours.row(i)) {
@@ -81,31 +83,28 @@ void HourglassControl<Dim>::apply(double dt, const Relation<Dim>& neighbours, Fi
             for (int d = 0; d < Dim; ++d) f[d] += force * x[d];
             kappa_sum -= kappa;
             dissipation += kappa * me * me;
-            // The stress mismatch (eq. (2.6.3)): its mean part in full, its deviator as far as
-            // neither node is at yield.
-            double sm[NS];
-            for (int c = 0; c < NS; ++c) {
-              double gx = 0.0;
-              for (int d = 0; d < Dim; ++d) gx += (a.G[d][c] + b.G[d][c]) * x[d];
-              sm[c] = a.s[c] - b.s[c] - 0.5 * gx;
-            }
-            const double mean = (sm[0] + sm[1] + sm[2]) / 3.0;
-            const double keep = 1.0 - std::max(a.yield, b.yield);
-            const double delta = 2.0 * zeta * c_bar * h * vv * dw_over_r;
-            for (int c = 0; c < 3; ++c) ds[c] += delta * (mean + keep * (sm[c] - mean));
-            for (int c = 3; c < NS; ++c) ds[c] += delta * keep * sm[c];
+            // The mean-stress mismatch (eq. (2.6.3)).
+            double gx = 0.0;
+            for (int d = 0; d < Dim; ++d) gx += (a.gm[d] + b.gm[d]) * x[d];
+            ds += 2.0 * zeta * c_bar * h * vv * dw_over_r * (a.mean - b.mean - 0.5 * gx);
           }
         }
         double power = 0.0;
-        // Where the velocity departs from its linear prediction at a Mach number beyond
-        // kLimiterMach (a shock), the first-order simple scheme's velocity (eq. (2.6.4)).
-        const double w = std::min(1.0, mismatch / kLimiterMach);
+        // Where the velocity departs from its linear prediction at a Mach number |m.e| / c beyond
+        // kMismatchMach, or the node is compressed at a Mach number h |div v| / c beyond
+        // kCompressionMach (a shock: 0.2 in Case 7's front, 1e-3 in Case 9's collapse), the
+        // first-order simple scheme's velocity (eq. (2.6.4)).
+        double divergence = 0.0;
+        for (int d = 0; d < Dim; ++d) divergence += a.L[d][d];
+        const double compression = -h * divergence / c_i;
+        const double w =
+            std::max(std::min(1.0, mismatch / kMismatchMach), std::clamp(compression / kCompressionMach - 1.0, 0.0, 1.0));
         for (int d = 0; d < Dim; ++d) {
           const double ad = (V_i > 0.0 ? f[d] / mass_i : 0.0) + (dt > 0.0 ? w * a.vs[d] / dt : 0.0);
           accel[iu * Dim + static_cast<std::size_t>(d)] = ad;
           power += f[d] * a.v[d];
         }
-        for (int c = 0; c < NS; ++c) dsigma[iu * NS + static_cast<std::size_t>(c)] = V_i > 0.0 ? ds[c] / V_i : 0.0;
+        dsigma[iu] = V_i > 0.0 ? ds / V_i : 0.0;
         acc[0] += power;
         acc[1] += 0.5 * dissipation;  // each pair is summed from both of its nodes
         theta[iu] = V_i > 0.0 ? dt * kappa_sum / mass_i : 0.0;
@@ -117,18 +116,24 @@ void HourglassControl<Dim>::apply(double dt, const Relation<Dim>& neighbours, Fi
         }
         acc[3] += dk;
       });
-  exec::particle_for(
-      m_.policy, n,
-      [&](Index i) {
+  // Apply, and the stored energy's change: V [σ* : C⁻¹ : Δσ + ½ Δσ : C⁻¹ : Δσ], Δσ = Δt dσ/dt.
+  const std::array<double, 1> strain = exec::particle_reduce<1>(
+      m_.policy, n, reduction_, [&](Index i, double* acc) {
         const auto iu = static_cast<std::size_t>(i);
         for (int d = 0; d < Dim; ++d) velocity(i, d) += dt * accel[iu * Dim + static_cast<std::size_t>(d)];
-        for (int c = 0; c < NS; ++c) {
-          const double ds = dsigma[iu * NS + static_cast<std::size_t>(c)];
+        Sym6 before{}, change{};
+        const double ds = dsigma[iu];
+        for (int c = 0; c < NS; ++c) before[static_cast<std::size_t>(c)] = stress(i, c);
+        for (int c = 0; c < 3; ++c) {
+          change[static_cast<std::size_t>(c)] = dt * ds;
           stress(i, c) += dt * ds;
           if (flux_rate != nullptr) flux_rate[iu * NS + static_cast<std::size_t>(c)] += ds;
         }
-      },
-      exec::Schedule::even, n);
+        const Sym6 e = m_.materials[static_cast<std::size_t>(set.material[iu])].elastic().apply_inverse(change);
+        for (std::size_t c = 0; c < 6; ++c) before[c] += 0.5 * change[c];
+        acc[0] += set.volume[iu] * tensor::ddot(before, e);
+      });
+  strain_change_ = strain[0];
   exchange_ = sums[0] - sums[1];
   dissipation_ = sums[1];
   theta_max_ = n > 0 ? *std::max_element(theta.begin(), theta.begin() + n) : 0.0;

@@ -208,6 +208,12 @@ EnergyBalance Simulation<Dim>::energy() const {
   e.external_work = clock_.external_work();
   e.damping_loss = clock_.damping_loss();
   e.initial_strain = clock_.initial_strain();
+  for (const auto& stage : scheme_->stages()) {
+    if (auto* owner = dynamic_cast<const SourceOwner<Dim>*>(stage.get())) {
+      e.plastic_dissipation = owner->sources().dissipation();
+      e.stabilisation_loss = owner->stabilisation_loss();
+    }
+  }
   return e;
 }
 

@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "io/state_archive.hpp"
+#include "materials/tensor.hpp"
 #include "schemes/hourglass_control.hpp"
 #include "operators/corrected_row.hpp"
 #include "operators/run_sums.hpp"
@@ -186,6 +187,36 @@ void ViscoplasticSources<Dim>::integrate(double tau, const SourceRuns& runs, Fie
 }
 
 template <int Dim>
+void ViscoplasticSources<Dim>::integrate_dissipating(double tau, const SourceRuns& runs, FieldView<double, NS> stress,
+                                                     FieldView<double, 0> history, const std::vector<double>& volume) {
+  integrate(tau, runs, stress, history);
+  if (run_dissipation_.size() < runs.size()) run_dissipation_.resize(runs.size());
+  // Per run in index order, then the runs in order: the same sum whatever the threads.
+  exec::particle_for(
+      exec::Threads{4}, static_cast<Index>(runs.size()),
+      [&](Index r) {
+        const auto [m, begin, end] = runs[static_cast<std::size_t>(r)];
+        const ElasticConstants& el = model_.materials[m].elastic();
+        double sum = 0.0;
+        for (Index i = begin; i < end; ++i) {
+          const double* start = sigma_start(i);
+          const double* rate = flux_rate(i);
+          Sym6 mid{}, drop{};
+          for (int c = 0; c < NS; ++c) {
+            const double trial = start[c] + tau * rate[c];
+            mid[static_cast<std::size_t>(c)] = 0.5 * (stress(i, c) + trial);
+            drop[static_cast<std::size_t>(c)] = trial - stress(i, c);
+          }
+          const Sym6 e = el.apply_inverse(drop);
+          sum += volume[static_cast<std::size_t>(i)] * tensor::ddot(mid, e);
+        }
+        run_dissipation_[static_cast<std::size_t>(r)] = sum;
+      },
+      exec::Schedule::dynamic);
+  for (std::size_t r = 0; r < runs.size(); ++r) dissipation_ += run_dissipation_[r];
+}
+
+template <int Dim>
 void ViscoplasticSources<Dim>::save(io::StateArchive& a, const std::string& prefix) const {
   a.put_integer(prefix + "max_source_substeps", stats_.max_substeps);
   a.put_integer(prefix + "source_rk4_substeps", stats_.total_substeps);
@@ -195,6 +226,7 @@ void ViscoplasticSources<Dim>::save(io::StateArchive& a, const std::string& pref
   a.put_integer(prefix + "source_newton_iterations", stats_.newton_iterations);
   a.put_integer(prefix + "source_max_newton_iterations", stats_.max_newton_iterations);
   a.put_integer(prefix + "source_max_implicit_pieces", stats_.max_implicit_pieces);
+  a.put(prefix + "plastic_dissipation", dissipation_);
 }
 
 template <int Dim>
@@ -210,6 +242,7 @@ void ViscoplasticSources<Dim>::load(const io::StateArchive& a, const std::string
   stats_.newton_iterations = count("source_newton_iterations");
   stats_.max_newton_iterations = count("source_max_newton_iterations");
   stats_.max_implicit_pieces = count("source_max_implicit_pieces");
+  dissipation_ = a.has(prefix + "plastic_dissipation") ? a.number(prefix + "plastic_dissipation") : 0.0;
 }
 
 // ---- step 1
@@ -464,7 +497,6 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
   const bool sources = sources_->active();
   ViscoplasticSources<Dim>& src = *sources_;
   HourglassControl<Dim>* hourglass = hourglass_.get();
-  const auto node_k = std::as_const(m_.nodes).view(m_.fields.history);
   if (hourglass != nullptr) hourglass->reserve(nodes.size());
   // The hourglass pass after the nodes' update, before their source (method-notes §2.6).
   auto control_hourglass = [&] {
@@ -473,6 +505,7 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
     hourglass->apply(dt, *hourglass_pairs_, node_v, node_s, sources ? src.flux_rate(0) : nullptr);
     hourglass_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     hourglass_kinetic_ += hourglass->kinetic_change();
+    hourglass_strain_ += hourglass->strain_change();
     hourglass_dissipation_ += dt * hourglass->dissipation();
     hourglass_exchange_ += dt * hourglass->exchange();
     hourglass_theta_ = std::max(hourglass_theta_, hourglass->theta_max());
@@ -564,15 +597,13 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
       // continuity; the position moved with the displacement (x - X = u).
       jaumann_rotate<Dim>(grad_v, dt, s);
       if (hourglass != nullptr) {
-        // What the hourglass control reads (method-notes eq. (2.6.1)): x^n, v^n and the updated
-        // velocity, L, the rotated stress plus half the step's flux, G, the yield ratio.
+        // What the hourglass control reads (method-notes eq. (2.6.1)): x^n, v^n, the updated and
+        // the simple scheme's velocities, L, the rotated stress plus half the step's flux, G.
         double s_tilde[NS];
         for (int k = 0; k < NS; ++k) s_tilde[k] = s[k] + 0.5 * dt * dsig[k];
-        const double* k_hist = node_k.components() > 0 ? node_k[i] : nullptr;
-        const double ratio = m_.materials[static_cast<std::size_t>(mat)].yield_ratio(to_sym6<Dim>(s_tilde), k_hist);
         double v_simple[Dim];
         for (int d = 0; d < Dim; ++d) v_simple[d] = damped_velocity(v_half[d], dv[d] + b[d], cd, 0.5 * dt);
-        hourglass->record(i, nodes.position[iu], v_n, v, grad_v, s_tilde, grad_s, ratio, v_simple);
+        hourglass->record(i, nodes.position[iu], v_n, v, v_simple, grad_v, s_tilde, grad_s);
       }
       continuity_and_move<Dim>(nodes, iu, grad_v, dt, v_half);
     }
@@ -624,7 +655,7 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
       m_.to_nodes.pair_count = counts.pairs;
       moving_->note_rows(m_.degenerate_operator_rows(), m_.regularised_operator_rows(), c.t);
       control_hourglass();
-      if (sources) src.integrate(dt, m_.node_sources, node_s, m_.nodes.view(m_.fields.history));
+      if (sources) src.integrate_dissipating(dt, m_.node_sources, node_s, m_.nodes.view(m_.fields.history), nodes.volume);
       return;
     }
   }
@@ -662,7 +693,7 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
       },
       exec::Schedule::even, nodes.size());
   control_hourglass();
-  if (sources) src.integrate(dt, m_.node_sources, node_s, m_.nodes.view(m_.fields.history));
+  if (sources) src.integrate_dissipating(dt, m_.node_sources, node_s, m_.nodes.view(m_.fields.history), nodes.volume);
 }
 
 template <int Dim, class Motion, class Velocity>
@@ -670,6 +701,7 @@ std::vector<std::pair<std::string, double>> NodeFullStep<Dim, Motion, Velocity>:
   if (hourglass_ == nullptr) return {};
   return {{"hourglass_seconds", hourglass_seconds_},
           {"hourglass_kinetic_change", hourglass_kinetic_},
+          {"hourglass_strain_change", hourglass_strain_},
           {"hourglass_dissipation", hourglass_dissipation_},
           {"hourglass_exchange", hourglass_exchange_},
           {"hourglass_theta_max", hourglass_theta_}};
@@ -678,11 +710,25 @@ std::vector<std::pair<std::string, double>> NodeFullStep<Dim, Motion, Velocity>:
 template <int Dim, class Motion, class Velocity>
 void NodeFullStep<Dim, Motion, Velocity>::save(io::StateArchive& a, const std::string& prefix) const {
   sources_->save(a, prefix);
+  if (hourglass_ != nullptr) {
+    a.put(prefix + "hourglass_kinetic_change", hourglass_kinetic_);
+    a.put(prefix + "hourglass_strain_change", hourglass_strain_);
+    a.put(prefix + "hourglass_dissipation", hourglass_dissipation_);
+    a.put(prefix + "hourglass_exchange", hourglass_exchange_);
+    a.put(prefix + "hourglass_theta_max", hourglass_theta_);
+  }
 }
 
 template <int Dim, class Motion, class Velocity>
 void NodeFullStep<Dim, Motion, Velocity>::load(const io::StateArchive& a, const std::string& prefix) {
   sources_->load(a, prefix);
+  if (hourglass_ != nullptr && a.has(prefix + "hourglass_kinetic_change")) {
+    hourglass_kinetic_ = a.number(prefix + "hourglass_kinetic_change");
+    hourglass_strain_ = a.number(prefix + "hourglass_strain_change");
+    hourglass_dissipation_ = a.number(prefix + "hourglass_dissipation");
+    hourglass_exchange_ = a.number(prefix + "hourglass_exchange");
+    hourglass_theta_ = a.number(prefix + "hourglass_theta_max");
+  }
 }
 
 // ---- checkerboard filters

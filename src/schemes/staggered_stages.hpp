@@ -38,6 +38,13 @@ class ViscoplasticSources {
   /// source-corrected value, the history at its new value (method-notes §2.2, additive or
   /// frozen-flux coupling).
   void integrate(double tau, const SourceRuns& runs, FieldView<double, NS> stress, FieldView<double, 0> history);
+  /// The same, and the plastic dissipation of the particles of `volume` (the nodes) added to
+  /// dissipation(): V (sigma_end + sigma_trial)/2 : C^-1 : (sigma_trial - sigma_end), the stored
+  /// energy the source removed, with sigma_trial = sigma_start + tau R (method-notes eq. (5.1.3)).
+  void integrate_dissipating(double tau, const SourceRuns& runs, FieldView<double, NS> stress,
+                             FieldView<double, 0> history, const std::vector<double>& volume);
+  /// The nodes' plastic dissipation so far, J.
+  double dissipation() const { return dissipation_; }
   /// The largest number of RK4 sub-steps one particle needed in one interval so far.
   long max_substeps() const { return stats_.max_substeps; }
   /// Every count of the integrations so far (RK4 sub-steps, backward-Euler particles and their
@@ -61,8 +68,10 @@ class ViscoplasticSources {
   StaggeredModel<Dim>& model_;
   std::vector<double> sigma_start_, rate_;
   std::vector<SourceStats> run_stats_;
+  std::vector<double> run_dissipation_;
   SourceStats stats_;
   double seconds_ = 0.0;
+  double dissipation_ = 0.0;
 };
 
 /// A stage that owns the viscoplastic sources of its scheme (step 2 of every instantiation), so
@@ -72,6 +81,9 @@ class SourceOwner {
  public:
   virtual ~SourceOwner() = default;
   virtual const ViscoplasticSources<Dim>& sources() const = 0;
+  /// The energy a stabilisation of the step removed from the nodes so far, J (V2's hourglass
+  /// control, method-notes §2.6; 0 without one).
+  virtual double stabilisation_loss() const { return 0.0; }
 };
 
 /// The pressure term of step 1 in a dry scheme: none.
@@ -140,6 +152,7 @@ class NodeFullStep final : public Stage, public SourceOwner<Dim> {
   }
   const HourglassControl<Dim>* hourglass() const { return hourglass_.get(); }
   std::vector<std::pair<std::string, double>> report() const override;
+  double stabilisation_loss() const override { return -(hourglass_kinetic_ + hourglass_strain_); }
 
  private:
   StaggeredModel<Dim>& m_;
@@ -150,8 +163,8 @@ class NodeFullStep final : public Stage, public SourceOwner<Dim> {
   const Relation<Dim>* hourglass_pairs_ = nullptr;
   // The hourglass control's figures over the run: seconds, energy removed from the nodal
   // velocity (kinetic change, J), its pure dissipation and exchange, the largest decay factor.
-  double hourglass_seconds_ = 0.0, hourglass_kinetic_ = 0.0, hourglass_dissipation_ = 0.0, hourglass_exchange_ = 0.0,
-         hourglass_theta_ = 0.0;
+  double hourglass_seconds_ = 0.0, hourglass_kinetic_ = 0.0, hourglass_strain_ = 0.0, hourglass_dissipation_ = 0.0,
+         hourglass_exchange_ = 0.0, hourglass_theta_ = 0.0;
 };
 
 /// The prescribed components at t^{n+1} (method-notes §4.1).

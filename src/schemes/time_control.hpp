@@ -24,8 +24,17 @@ struct EnergyBalance {
   double external_work = 0.0;   // work of boundary tractions and body forces since t = 0, J
   double damping_loss = 0.0;    // energy removed by the velocity damping, J
   double initial_strain = 0.0;  // stored energy of the initial state, J
-  /// kinetic + strain - initial strain - external work + damping loss (zero if conserved)
-  double imbalance() const { return kinetic + strain - initial_strain - external_work + damping_loss; }
+  /// The nodes' plastic dissipation since t = 0, J: the stored energy the viscoplastic source
+  /// removed from the nodal stress (method-notes eq. (5.1.3)).
+  double plastic_dissipation = 0.0;
+  /// The energy V2's hourglass control removed from the nodal velocity and stress since t = 0, J
+  /// (method-notes §2.6; 0 without it).
+  double stabilisation_loss = 0.0;
+  /// kinetic + strain - initial strain - external work + damping loss + plastic dissipation +
+  /// stabilisation loss: zero for an exact account, so it measures the discretisation's error.
+  double imbalance() const {
+    return kinetic + strain - initial_strain - external_work + damping_loss + plastic_dissipation + stabilisation_loss;
+  }
 };
 
 /// What the end of a step needs from the particles: momentum (Dim), sum m v^2, a flag set when a
