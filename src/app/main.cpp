@@ -130,6 +130,9 @@ int main(int argc, char** argv) {
       ->required()
       ->check(CLI::ExistingFile);
   check_cmd->add_option("--set,-s", check.overrides, "Override a case key in every file, as for run");
+  check_cmd->add_option("--threads,-j", check.threads, "Threads for the run-time estimate (default as for run)")
+      ->check(CLI::NonNegativeNumber);
+  check_cmd->add_flag("!--no-estimate", check.estimate, "Skip the trial steps that estimate the run time");
 
   std::string mp_file, mp_out;
   std::vector<std::string> mp_overrides;

@@ -30,10 +30,13 @@ TEST(CheckCase, SoundAndUnsoundFilesEachGetTheirLine) {
   EXPECT_NE(ok.out.find("ok    " + good + ": v2 2D, 3321 nodes, 3200 stress points, 2 rigid bodies"), std::string::npos)
       << ok.out;
   EXPECT_NE(ok.out.find("58704 steps to 20 s"), std::string::npos) << ok.out;
+  // The run-time estimate from trial steps, with the plastic bound of a Perzyna material.
+  EXPECT_NE(ok.out.find("estimate: "), std::string::npos) << ok.out;
+  EXPECT_NE(ok.out.find("if every particle flows plastically"), std::string::npos) << ok.out;
   EXPECT_NE(ok.out.find("ok    " + point + ": material point, simple_shear path"), std::string::npos) << ok.out;
   EXPECT_NE(ok.out.find("2 of 2 case files sound"), std::string::npos) << ok.out;
 
-  const auto mixed = test::run_command(fmt::format("cd \"{}\" && \"{}\" check \"{}\" \"{}\" --set time.cfl=0.25 2>&1",
+  const auto mixed = test::run_command(fmt::format("cd \"{}\" && \"{}\" check --no-estimate \"{}\" \"{}\" --set time.cfl=0.25 2>&1",
                                                    dir.path().string(), RKTSPH_BINARY, bad, good));
   EXPECT_EQ(mixed.status, 2) << mixed.out;
   EXPECT_NE(mixed.out.find("error " + bad + ", line"), std::string::npos) << mixed.out;
@@ -41,6 +44,7 @@ TEST(CheckCase, SoundAndUnsoundFilesEachGetTheirLine) {
       << mixed.out;
   EXPECT_NE(mixed.out.find("117408 steps to 20 s"), std::string::npos) << mixed.out;  // --set reaches every file
   EXPECT_NE(mixed.out.find("1 of 2 case files sound"), std::string::npos) << mixed.out;
+  EXPECT_EQ(mixed.out.find("estimate: "), std::string::npos) << mixed.out;
   // Nothing written: no out/ folder beside the call.
   EXPECT_FALSE(std::filesystem::exists(dir.file("out")));
 }
