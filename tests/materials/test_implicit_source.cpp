@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <numbers>
 #include <string>
@@ -15,10 +16,15 @@
 #include "case/case_builder.hpp"
 #include "core/error.hpp"
 #include "material_test_util.hpp"
-#include "materials/perzyna_models.hpp"
-#include "schemes/simulation.hpp"
+#include "materials/hardening.hpp"
+#include "materials/lode_form.hpp"
 #include "materials/material_point_path.hpp"
+#include "materials/perzyna.hpp"
+#include "materials/perzyna_models.hpp"
 #include "materials/tensor.hpp"
+#include "materials/yield_cam_clay.hpp"
+#include "materials/yield_mohr_coulomb.hpp"
+#include "schemes/simulation.hpp"
 
 namespace rktsph {
 namespace {
@@ -319,6 +325,136 @@ TEST(ImplicitSource, EverySchemeReportsItsSourceCounts) {
     EXPECT_GT(s.newton_iterations, s.implicit_points / 2) << scheme;
     EXPECT_GT(s.elastic_points + s.rk4_points + s.implicit_points, 40 * 100) << scheme;
     EXPECT_GE(solver.source_seconds(), 0.0);
+  }
+}
+
+// ---- the (p', q, theta) return of the Lode-dependent surfaces (method-notes eqs. (2.5.11)–(2.5.15))
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+// A stress of mean -p, size q and Lode angle theta (eq. (1.1.3), tension positive: +30 deg is
+// triaxial compression), its principal axes turned away from x, y, z by `turn` radians.
+Sym6 stress_of(double p, double q, double theta, double turn = 0.4) {
+  const double s1 = 2.0 * q / 3.0 * std::sin(theta + 2.0 * std::numbers::pi / 3.0);
+  const double s2 = 2.0 * q / 3.0 * std::sin(theta);
+  const double s3 = 2.0 * q / 3.0 * std::sin(theta - 2.0 * std::numbers::pi / 3.0);
+  // R = Rz(turn) Rx(0.7 turn) applied to diag(s1, s2, s3): R diag R^T.
+  const double c = std::cos(turn), s = std::sin(turn), cx = std::cos(0.7 * turn), sx = std::sin(0.7 * turn);
+  const double R[3][3] = {{c, -s * cx, s * sx}, {s, c * cx, -c * sx}, {0.0, sx, cx}};
+  const double d[3] = {s1, s2, s3};
+  double m[3][3];
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      m[i][j] = 0.0;
+      for (int k = 0; k < 3; ++k) m[i][j] += R[i][k] * d[k] * R[j][k];
+    }
+  }
+  return {m[0][0] - p, m[1][1] - p, m[2][2] - p, m[0][1], m[1][2], m[0][2]};
+}
+
+double lode_sin3(const Sym6& sigma) {
+  const Sym6 s = tensor::deviator(sigma);
+  return MohrCoulombSurface::lode_x(s, 0.5 * tensor::ddot(s, s), 1.0);
+}
+
+TEST(ImplicitSource, CoaxialPlaneTurnsTheLodeAngleAsTheSurfacesMeasureIt) {
+  // Along e2 the Lode angle falls: theta = theta_tr - b (eq. (2.5.11)), folded past the corners.
+  for (double theta : {-30.0, -29.999, -29.8, -20.0, -3.0, 0.0, 11.0, 29.5, 29.99, 30.0}) {
+    const Sym6 trial = stress_of(1e4, 3e4, theta * kDeg);
+    const CoaxialPlane plane = CoaxialPlane::of(tensor::deviator(trial), 1e-9);
+    ASSERT_TRUE(plane.has_e1);
+    EXPECT_NEAR(plane.theta, theta * kDeg, 1e-12) << theta;
+    EXPECT_EQ(plane.has_e2, std::abs(theta) < 29.9999) << theta;
+    if (!plane.has_e2) continue;
+    // e2 is the part of dev(s^2) normal to s, of size cos(3 theta): its round-off grows near the corners.
+    const double tolerance = 1e-12 + 1e-15 / std::cos(3.0 * plane.theta);
+    for (double b : {-1.5, -1.0, -0.6, -0.1, -1e-4, 0.0, 2e-3, 0.3, 0.8, 1.04, 1.5}) {
+      const Sym6 s = plane.deviator(2.5e4, b);
+      const FoldedLodeAngle a = plane.lode_angle(std::cos(b), std::sin(b));
+      const double folded = std::atan2(a.lode.sin1, a.lode.cos1);
+      EXPECT_NEAR(invariants(s).q, 2.5e4, 1e-10 * 2.5e4);
+      EXPECT_NEAR(a.lode.sin3, lode_sin3(s), tolerance) << theta << " " << b;
+      EXPECT_NEAR(a.lode.sin3, std::sin(3.0 * (plane.theta - b)), 1e-12) << theta << " " << b;
+      EXPECT_LE(std::abs(folded), std::numbers::pi / 6.0 + 1e-12) << theta << " " << b;
+      EXPECT_NEAR(a.lode.sin3, std::sin(3.0 * folded), 1e-12) << theta << " " << b;
+      EXPECT_NEAR(a.lode.cos3, std::cos(3.0 * folded), 1e-12) << theta << " " << b;
+      // dtheta/db = -sign, by differences (away from the corners, where the fold turns).
+      const double h = 1e-7;
+      const FoldedLodeAngle up = plane.lode_angle(std::cos(b + h), std::sin(b + h));
+      const FoldedLodeAngle down = plane.lode_angle(std::cos(b - h), std::sin(b - h));
+      if (std::abs(std::abs(folded) - std::numbers::pi / 6.0) > 1e-5) {
+        const double slope =
+            (std::atan2(up.lode.sin1, up.lode.cos1) - std::atan2(down.lode.sin1, down.lode.cos1)) / (2 * h);
+        EXPECT_NEAR(slope, -a.sign, 1e-6) << theta << " " << b;
+      }
+    }
+  }
+}
+
+// The form against the surface's own value() and flow() at (p', q, theta), and its second
+// derivatives against central differences of the first.
+template <class Surface>
+void check_lode_form(const Surface& surface, double p, double q, double theta, double Y, const std::string& what) {
+  const Sym6 sigma = stress_of(p, q, theta);
+  const LodeForm f = surface.pq_theta(p, q, LodeAngle::of(theta), Y);
+  const double scale = std::max({std::abs(f.F), Y, q});
+  EXPECT_NEAR(f.F, surface.value(sigma, Y), 1e-12 * scale) << what;
+  // m = -(Q_p/3) 1 + sqrt(3/2) (Q_q e1 - (Q_theta/q) e2) in the plane of sigma (eq. (2.5.13)).
+  const CoaxialPlane plane = CoaxialPlane::of(tensor::deviator(sigma), 1e-9 * Y);
+  const Sym6 m = surface.flow(sigma, Y);
+  const double size = std::max({std::abs(f.Q_p), std::abs(f.Q_q), std::abs(f.Q_theta / q), 1.0});
+  EXPECT_NEAR(-tensor::trace(m), f.Q_p, 1e-11 * size) << what;
+  EXPECT_NEAR(tensor::ddot(m, plane.e1), std::sqrt(1.5) * f.Q_q, 1e-11 * size) << what;
+  if (plane.has_e2) {
+    EXPECT_NEAR(tensor::ddot(m, plane.e2), -std::sqrt(1.5) * f.Q_theta / q, 1e-9 * size) << what;
+  }
+  // Second derivatives.
+  const double hp = 1e-6 * std::max(std::abs(p), Y), hq = 1e-6 * q, ht = 1e-6, hY = 1e-6 * Y;
+  auto at = [&](double dp, double dq, double dt, double dY) {
+    return surface.pq_theta(p + dp, q + dq, LodeAngle::of(theta + dt), Y + dY);
+  };
+  const LodeForm pp = at(hp, 0, 0, 0), pm = at(-hp, 0, 0, 0), qp = at(0, hq, 0, 0), qm = at(0, -hq, 0, 0);
+  const LodeForm tp = at(0, 0, ht, 0), tm = at(0, 0, -ht, 0), Yp = at(0, 0, 0, hY), Ym = at(0, 0, 0, -hY);
+  auto expect = [&](double analytic, double difference, double unit, const char* name) {
+    EXPECT_NEAR(analytic, difference, 1e-6 * std::max(std::abs(analytic), unit)) << what << " " << name;
+  };
+  expect(f.F_p, (pp.F - pm.F) / (2 * hp), 1.0, "F_p");
+  expect(f.F_q, (qp.F - qm.F) / (2 * hq), 1.0, "F_q");
+  expect(f.F_theta, (tp.F - tm.F) / (2 * ht), q, "F_theta");
+  expect(f.F_Y, (Yp.F - Ym.F) / (2 * hY), 1.0, "F_Y");
+  expect(f.Q_pp, (pp.Q_p - pm.Q_p) / (2 * hp), 1.0 / Y, "Q_pp");
+  expect(f.Q_pq, (qp.Q_p - qm.Q_p) / (2 * hq), 1.0 / Y, "Q_pq");
+  expect(f.Q_ptheta, (tp.Q_p - tm.Q_p) / (2 * ht), 1.0, "Q_ptheta");
+  expect(f.Q_ptheta, (pp.Q_theta - pm.Q_theta) / (2 * hp), 1.0, "Q_thetap");
+  expect(f.Q_qq, (qp.Q_q - qm.Q_q) / (2 * hq), 1.0 / Y, "Q_qq");
+  expect(f.Q_qtheta, (tp.Q_q - tm.Q_q) / (2 * ht), 1.0, "Q_qtheta");
+  expect(f.Q_qtheta, (qp.Q_theta - qm.Q_theta) / (2 * hq), 1.0, "Q_thetaq");
+  expect(f.Q_thetatheta, (tp.Q_theta - tm.Q_theta) / (2 * ht), q, "Q_thetatheta");
+  expect(f.Q_pY, (Yp.Q_p - Ym.Q_p) / (2 * hY), 1.0 / Y, "Q_pY");
+  expect(f.Q_qY, (Yp.Q_q - Ym.Q_q) / (2 * hY), 1.0 / Y, "Q_qY");
+  expect(f.Q_thetaY, (Yp.Q_theta - Ym.Q_theta) / (2 * hY), 1.0, "Q_thetaY");
+}
+
+TEST(ImplicitSource, LodeFormsAreTheSurfacesInInvariants) {
+  const std::vector<double> thetas{-29.95, -29.0, -12.0, 0.0, 7.0, 28.0, 29.8, 29.97};
+  for (double eps : {0.0, 0.1}) {
+    for (double psi : {0.0, 10.0, 30.0}) {
+      const MohrCoulombSurface mc = MohrCoulombSurface::make(30.0 * kDeg, psi * kDeg, eps);
+      for (double theta : thetas) {
+        for (double q : {0.05, 1.0, 20.0}) {
+          check_lode_form(mc, 2.0, q, theta * kDeg, 1.0,
+                          fmt::format("MC eps {} psi {} theta {} q {}", eps, psi, theta, q));
+        }
+      }
+    }
+  }
+  CamClaySurface cc;
+  cc.M_c = 1.2;
+  cc.lode_dependent = true;
+  for (double theta : thetas) {
+    for (double p : {0.3, 0.7, 1.4}) {
+      check_lode_form(cc, p * 1e5, 0.6e5, theta * kDeg, 1e5, fmt::format("CC theta {} p {}", theta, p));
+    }
   }
 }
 
