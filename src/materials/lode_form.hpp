@@ -5,6 +5,7 @@
 //   m = dQ/dsigma = -(Q_p/3) 1 + Q_q (3/2) s/q + Q_theta dtheta/dsigma,
 // and dtheta/dsigma lies in the coaxial deviatoric plane, normal to s, of size 1/|s|. The second
 // derivatives (along p', q, theta and the size Y) are those of the exact Newton Jacobian.
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <numbers>
@@ -62,9 +63,21 @@ struct FoldedLodeAngle {
 /// J3 grows at fixed J2, and sin 3 theta falls.
 struct CoaxialPlane {
   Sym6 e1{}, e2{};
-  double theta = 0.0, cos_theta = 1.0, sin_theta = 0.0;  // the trial's Lode angle
-  bool has_e1 = false;                                   // s_tr is not round-off
-  bool has_e2 = false;                                   // s_tr is off the triaxial corners
+  double cos_theta = 1.0, sin_theta = 0.0;  // the trial's Lode angle
+  bool has_e1 = false;                      // s_tr is not round-off
+  bool has_e2 = false;                      // s_tr is off the triaxial corners
+
+  double theta() const { return std::atan2(sin_theta, cos_theta); }
+
+  /// cos theta and sin theta of theta in [-pi/6, pi/6] from c3 = cos 3 theta >= 0 and
+  /// s3 = sin 3 theta, without atan2, sin and cos: Newton on 4c^3 - 3c = c3, convex with a slope
+  /// of 6 to 9 on [cos 30 deg, 1], from the right (c0 = 1 - (1 - c3)/9, the second-order
+  /// expansion, lies above the root), then s = s3/(4c^2 - 1), as 3 - 4s^2 = 4c^2 - 1 in [2, 3].
+  static void third_angle(double c3, double s3, double& c, double& s) {
+    c = 1.0 - (1.0 - c3) / 9.0;
+    for (int it = 0; it < 5; ++it) c -= (c * (4.0 * c * c - 3.0) - c3) / (12.0 * c * c - 3.0);
+    s = s3 / (4.0 * c * c - 1.0);
+  }
 
   /// The plane of s (deviatoric); no e1 below |s| = floor.
   static CoaxialPlane of(const Sym6& s, double floor) {
@@ -80,14 +93,15 @@ struct CoaxialPlane {
       // sin 3 theta = -3 sqrt6 det(e1) and cos 3 theta = sqrt6 dev(e1^2) : e2 >= 0, the latter
       // from d(sin 3 theta)/db = -3 cos 3 theta: exact near the corners, where asin is not.
       const double root6 = std::sqrt(6.0);
-      c.theta = std::atan2(-3.0 * root6 * tensor::determinant(c.e1), root6 * nt / (ns * ns)) / 3.0;
+      const double s3 = std::clamp(-3.0 * root6 * tensor::determinant(c.e1), -1.0, 1.0);
+      const double c3 = std::min(root6 * nt / (ns * ns), 1.0);
+      const double norm = 1.0 / std::sqrt(s3 * s3 + c3 * c3);  // round-off off the unit circle
+      third_angle(c3 * norm, s3 * norm, c.cos_theta, c.sin_theta);
       if (nt > 1e-8 * ns * ns) {  // the generic return's test (implicit_source.hpp)
         c.has_e2 = true;
         c.e2 = tensor::scaled(t, 1.0 / nt);
       }
     }
-    c.cos_theta = std::cos(c.theta);
-    c.sin_theta = std::sin(c.theta);
     return c;
   }
 

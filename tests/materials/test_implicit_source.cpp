@@ -363,18 +363,18 @@ TEST(ImplicitSource, CoaxialPlaneTurnsTheLodeAngleAsTheSurfacesMeasureIt) {
     const Sym6 trial = stress_of(1e4, 3e4, theta * kDeg);
     const CoaxialPlane plane = CoaxialPlane::of(tensor::deviator(trial), 1e-9);
     ASSERT_TRUE(plane.has_e1);
-    EXPECT_NEAR(plane.theta, theta * kDeg, 1e-12) << theta;
+    EXPECT_NEAR(plane.theta(), theta * kDeg, 1e-12) << theta;
     EXPECT_EQ(plane.has_e2, std::abs(theta) < 29.9999) << theta;
     if (!plane.has_e2) continue;
     // e2 is the part of dev(s^2) normal to s, of size cos(3 theta): its round-off grows near the corners.
-    const double tolerance = 1e-12 + 1e-15 / std::cos(3.0 * plane.theta);
+    const double tolerance = 1e-12 + 1e-15 / std::cos(3.0 * plane.theta());
     for (double b : {-1.5, -1.0, -0.6, -0.1, -1e-4, 0.0, 2e-3, 0.3, 0.8, 1.04, 1.5}) {
       const Sym6 s = plane.deviator(2.5e4, b);
       const FoldedLodeAngle a = plane.lode_angle(std::cos(b), std::sin(b));
       const double folded = std::atan2(a.lode.sin1, a.lode.cos1);
       EXPECT_NEAR(invariants(s).q, 2.5e4, 1e-10 * 2.5e4);
       EXPECT_NEAR(a.lode.sin3, lode_sin3(s), tolerance) << theta << " " << b;
-      EXPECT_NEAR(a.lode.sin3, std::sin(3.0 * (plane.theta - b)), 1e-12) << theta << " " << b;
+      EXPECT_NEAR(a.lode.sin3, std::sin(3.0 * (plane.theta() - b)), 1e-12) << theta << " " << b;
       EXPECT_LE(std::abs(folded), std::numbers::pi / 6.0 + 1e-12) << theta << " " << b;
       EXPECT_NEAR(a.lode.sin3, std::sin(3.0 * folded), 1e-12) << theta << " " << b;
       EXPECT_NEAR(a.lode.cos3, std::cos(3.0 * folded), 1e-12) << theta << " " << b;
