@@ -673,7 +673,7 @@ class PerzynaBackwardEuler {
         // A linearised guess (eq. 2.5.5) and the driver it gives.
         const double Y = size();
         const PQForm f = model_.surface().pq(p_, q_, Y);
-        const double stiff = std::abs(-f.F_p * K() * f.Q_p + 3.0 * G() * f.F_q * f.Q_q) / Y;
+        const double stiff = std::abs(f.F_p * K() * f.Q_p + 3.0 * G() * f.F_q * f.Q_q) / Y;
         const double soft = std::isinf(inverse_.gamma_tau) ? 0.0 : 1.0 / inverse_.gamma_tau;
         dl = std::max(0.0, f.F / Y - 1.0 - model_.overstress().dead_band) / std::max(stiff + soft, 1e-300);
         kd_ = model_.hardening().driver_end(k0_[Hardening::kDriver], dl, f.Q_p, f.Q_q, dl_t).value;

@@ -197,8 +197,19 @@ CaseReport validate_case07(const Options& opt, const std::string& dir) {
       worst_sigma = std::max(worst_sigma, std::abs(sig / count / sigma_push - 1.0));
       worst_overshoot = std::max(worst_overshoot, smin / sigma_push - 1.0);
     }
-    rep.metrics.push_back(metric(row("push", "shock position error at 0.06 / 0.12 s (max)"),
-                                 worst_front, "<=", 2.0, "dx"));
+    {
+      Metric front = metric(row("push", "shock position error at 0.06 / 0.12 s (max)"), worst_front, "<=", 2.0, "dx");
+      if (!front.pass()) {
+        front.known_deviation =
+            "the second-order step is dispersive: behind the front it leaves a trailing wave train (lambda down to "
+            "0.787 against the plateau's 0.810 at dx = 0.05 m) that takes up part of the compression, so the "
+            "mid-jump lags the exact shock by 0.14 m at dx = 0.05 m and 0.11 m at dx = 0.025 m (2.8 and 4.5 dx: it "
+            "converges, slowly); the shock limiter (method-notes eq. (2.6.4)) blends the simple scheme in at the "
+            "front only, where the compression Mach number is 0.2, not in the train behind it (Mach 0.004); the "
+            "simple scheme alone is within 2 dx";
+      }
+      rep.metrics.push_back(front);
+    }
     rep.metrics.push_back(
         metric(row("push", "plateau lambda error"), worst_lambda, "<=", 0.02, ""));
     rep.metrics.push_back(metric(row("push", "plateau sigma error"), worst_sigma, "<=", 0.02, ""));
@@ -241,9 +252,11 @@ CaseReport validate_case07(const Options& opt, const std::string& dir) {
       Metric fan = metric(row("pull", "fan e2(lambda - 1)"), worst_fan, "<=", 0.03, "");
       if (!fan.pass()) {
         fan.known_deviation =
-            "the simple second step is first order and diffusive (method-notes §2.3): it smears the fan, which is only "
-            "15 dx wide at 0.12 s (dx = 0.05 m), over about 1 m; e2 falls as about dx^0.35 (convergence rows below); "
-            "V1's step 2 with the filter halves it";
+            "the fan is only 15 dx wide at 0.12 s (dx = 0.05 m); the hourglass control's first-order parts (the "
+            "limiter's blend of the simple scheme where the velocity departs from linear, at the fan's head and "
+            "tail, and the mean-stress diffusion) round its corners: e2 0.19 at dx = 0.05 m, 0.12 at 0.025 m, "
+            "about dx^0.66 (convergence rows below); the Taylor-Galerkin step alone gives 0.20 / 0.13, the simple "
+            "scheme 0.29 / 0.25";
       }
       rep.metrics.push_back(fan);
     }
@@ -280,7 +293,7 @@ CaseReport validate_case07(const Options& opt, const std::string& dir) {
                  sig_small / count, "", 0.0, "Pa"));
     }
   }
-  // ---- the fan against the resolution, the simple scheme against V1's step 2 (reported)
+  // ---- the fan against the resolution, for each of V2's velocity updates (reported)
   auto fan_error = [&](const BarRun& r) {
     const Profile& pr = r.profiles.back();
     double num = 0.0, den = 0.0;
@@ -294,7 +307,7 @@ CaseReport validate_case07(const Options& opt, const std::string& dir) {
   };
   for (double dx : {0.05, 0.025, 0.0125}) {
     for (const char* update : {"simple", "taylor_galerkin", "hourglass"}) {
-      if (dx == 0.0125 && !opt.full && std::string(update) != "simple") continue;
+      if (dx == 0.0125 && !opt.full && std::string(update) != "hourglass") continue;
       const BarRun r = run_bar(case_file, dx, -kV0, "v2", update);
       total_seconds += r.seconds;
       rep.metrics.push_back(metric(fmt::format("pull, dx = {}, velocity update {}: fan e2 at 0.12 s", dx, update),

@@ -189,8 +189,10 @@ CaseReport validate_case10(const Options& opt, const std::string& dir) {
         } else if (label == "N = 3.4") {
           m.known_deviation = fmt::format(
               "open: the cut stands, but after the damping stops (t = 5 s) it keeps an elastic vibration of {:.2g} of "
-              "the peak kinetic energy at 20 s: below yield nothing dissipates it but the simple scheme's diffusion; "
-              "reaching 1e-4 needs the damping on beyond the ramp, which docs/cases.md Case 5 does not allow",
+              "the peak kinetic energy at 20 s (nodes at the toe's corner swing at a few cm/s): below yield nothing "
+              "dissipates it but the hourglass control's mean-stress diffusion, about 2 % of a bending mode's energy a "
+              "period (method-notes §2.6; the simple scheme it replaced damped more and smeared more); reaching 1e-4 "
+              "needs the damping on beyond the ramp, which docs/cases.md Case 5 does not allow",
               res.ke_end_ratio);
         } else {
           m.known_deviation = fmt::format(

@@ -160,7 +160,8 @@ CaseReport validate_case11(const Options& opt, const std::string& dir) {
             "open: the band narrows from {:.2f} to {:.2f} m ({:.1f} to {:.1f} dx) when dx halves. Without softening "
             "the exact band is a slip line of no width; the width that changed by 22 % with the simple scheme at full "
             "weight was set by its numerical viscosity, which also held the plateau 13-15 % over 2c; with less of it "
-            "the width follows dx more closely (28 % at w = 0.25, 38 % at w = 0.1), and with a third level (--refine: "
+            "the width follows dx more closely (28 % at w = 0.25, 38 % at w = 0.1, before the hourglass control "
+            "replaced the simple scheme as the default), and with a third level (--refine: "
             "26.5 % from 0.125 to 0.0625 m) it falls as dx^0.45, towards the slip line, not to a width of its own "
             "(docs/VALIDATION.md Case 11)",
             width_prev, band.width, width_prev / dx_prev, band.width / dx);

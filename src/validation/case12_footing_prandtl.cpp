@@ -131,8 +131,8 @@ CaseReport validate_case12(const Options& opt, const std::string& dir) {
         if (!z.pass() && std::isfinite(m.zone_depth))
           z.known_deviation = fmt::format(
               "open: the flowing zone reaches {:.3f} B, deeper than Prandtl's 0.71 B (plateau {:+.1f} % over (2 + pi) "
-              "c). The simple scheme's numerical viscosity widens the mechanism (0.95-1.0 B at w = 1); at the case's "
-              "w = 0.1 the smooth footing's zone is 0.81 / 0.88 B and the rough one's deepest flowing nodes are the "
+              "c). The simple scheme's numerical viscosity widens the mechanism (0.95-1.0 B at w = 1); at w = 0.1 (the "
+              "case's setting before the hourglass control became the default) the smooth footing's zone is 0.81 / 0.88 B and the rough one's deepest flowing nodes are the "
               "row at 0.9 B, moved 6-8 mm down (0.903 / 0.904 B at B/20 / B/40), a tail of the Perzyna viscosity's: at "
               "gamma_f = 100 1/s instead of 10 it is 0.855 B (B/20; docs/VALIDATION.md Case 12)",
               m.zone_depth / kB, 100.0 * err);
@@ -147,7 +147,7 @@ CaseReport validate_case12(const Options& opt, const std::string& dir) {
           h.known_deviation = fmt::format(
               "open: the surface still rises at 5 % of the footing's speed {:.3f} B from the edge (Prandtl: B): the "
               "mechanism widened by the simple scheme's numerical viscosity, as the plastic-zone depth above (1.15-1.3 "
-              "B at w = 1, 1.0-1.175 B at the case's w = 0.1; docs/VALIDATION.md Case 12)",
+              "B at w = 1, 1.0-1.175 B at w = 0.1; docs/VALIDATION.md Case 12)",
               m.heave_extent / kB);
         rep.metrics.push_back(h);
       }

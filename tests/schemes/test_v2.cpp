@@ -46,7 +46,11 @@ TEST(V2, AUniformStressRotatesObjectivelyOverAQuarterTurn) {
   const test::RotationCheck r = test::spin_rigidly(sim, steps, 0.75);  // faces are traction-free
   ASSERT_NEAR(sim.time(), 1.0, 1e-12);
   ASSERT_GT(r.nodes, 100);
-  EXPECT_LT(r.worst / 3.0e4, 1e-11) << "max stress error " << r.worst << " Pa";
+  // The hourglass control's mean-stress diffusion (method-notes eq. (2.6.3)) acts on the jump at
+  // the traction-free faces (this held block is not in equilibrium there) at O(c dt) a step and
+  // reaches the interior: 5.5e-9 of the stress measured (the simple scheme: round-off, 1e-11;
+  // issue 49 asks 1e-6 of the invariants).
+  EXPECT_LT(r.worst / 3.0e4, 1e-8) << "max stress error " << r.worst << " Pa";
   const std::vector<Index> at = sim.nodes_by_id();
   // The body turned: a corner node is where the rotation took it (to the first order of dt).
   EXPECT_NEAR(sim.nodes().position[static_cast<std::size_t>(at[0])][0], 1.0, 0.02);
@@ -325,10 +329,14 @@ nu = 0.0
 density = 2000.0
 [solver]
 version = "v2"
+velocity_update = "simple"
 [time]
 end = 0.12
 cfl = 0.5
 )";
+  // The thesis's simple scheme: the point here is the 3D machinery against 1D and the exact shock;
+  // V2's default (the hourglass control, method-notes §2.6) leaves a shock's front 2-3 dx behind
+  // (Case 7's known deviation, eq. (2.6.4)).
   const std::string bar_3d = fmt::format(R"(
 [geometry]
 dimension = 3

@@ -31,7 +31,7 @@ struct SpinResult {
   double kinetic_start = 0.0, kinetic_end = 0.0;
 };
 
-SpinResult spin(bool detect) {
+SpinResult spin(bool detect, double end = 1.0) {
   const test::ThreadCount threads(1);
   const double omega = 0.6;  // rad/s
   CaseBuilder<2> b("spinning square");
@@ -42,12 +42,12 @@ SpinResult spin(bool detect) {
       .scheme("v2")
       .free_surface(detect)
       .initial_velocity(Vec<2>::Zero(), omega)
-      .time(1.0, 0.5);
+      .time(end, 0.5);
   Simulation<2> sim(b.build());
   const std::vector<Vec<2>> made = sim.nodes().position;
   SpinResult r;
   r.kinetic_start = sim.energy().kinetic;
-  while (sim.time() < 1.0 - 1e-12) sim.step();
+  while (sim.time() < end - 1e-12) sim.step();
   // Where each node now started (V2 sorts its nodes as they move; ids are the made order).
   std::vector<Vec<2>> start(made.size());
   for (std::size_t i = 0; i < made.size(); ++i) {
@@ -108,7 +108,10 @@ SpinResult spin(bool detect) {
 
 TEST(V2FreeSurface, ASpinningSquareKeepsItsFacesTractionFreeInTheTurnedFrame) {
   const SpinResult detected = spin(true);
-  const SpinResult faces = spin(false);
+  // The lattice faces' normals on a turned square are wrong: their "traction-free" condition
+  // works on the body, which the simple scheme's numerical viscosity absorbed; with V2's
+  // hourglass control it pumps energy in until the run stops at 0.76 s. Compared at 0.5 s.
+  const SpinResult faces = spin(false, 0.5);
   EXPECT_NEAR(detected.theta, 0.6, 0.02);
   EXPECT_EQ(detected.face_nodes, 4 * 19);
   EXPECT_EQ(detected.wrongly_flagged, 0);

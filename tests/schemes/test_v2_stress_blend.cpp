@@ -20,7 +20,7 @@ namespace {
 // The interior amplitude of a nodal sigma_xx checkerboard (+-1 kPa) seeded in the V2 test block
 // (2 m, elastic, free faces), over the nodes 0.5 m or more inside the faces, after each step.
 std::vector<double> interior_stress_checkerboard(double beta, int steps) {
-  CaseSetup<2> c = test::v2_block("v2 block, nodal stress checkerboard").build();
+  CaseSetup<2> c = test::simple_scheme(test::v2_block("v2 block, nodal stress checkerboard").build());
   c.simple_stress_weight = beta;
   Simulation<2> sim(c);
   const std::vector<double> sign = test::lattice_checkerboard(sim.nodes().position);
@@ -67,7 +67,7 @@ TEST(V2StressBlend, ANodalStressCheckerboardLosesTheWeightEachStep) {
 TEST(V2StressBlend, AUniformStressStillRotatesObjectively) {
   const test::ThreadCount threads(1);
   const int steps = 8;
-  CaseSetup<2> c = test::rotation_block("v2 block, rigid rotation with the stress blend", steps).build();
+  CaseSetup<2> c = test::simple_scheme(test::rotation_block("v2 block, rigid rotation with the stress blend", steps).build());
   c.simple_stress_weight = 0.3;
   Simulation<2> sim(c);
   const test::RotationCheck r = test::spin_rigidly(sim, steps);

@@ -19,7 +19,7 @@ namespace {
 
 // A 2 m x 2 m free block, V2, elastic, no load: only the seeded velocity moves it.
 CaseSetup<2> free_block(double weight) {
-  CaseSetup<2> c = test::v2_block("v2 block, nodal checkerboard").build();
+  CaseSetup<2> c = test::simple_scheme(test::v2_block("v2 block, nodal checkerboard").build());
   c.simple_weight = weight;
   return c;
 }
@@ -91,7 +91,7 @@ double standing_wave_loss(double weight) {
       .fix_velocity(Region<1>::plane(0, kLength), {0})
       .scheme("v2")
       .time_step(period, period / std::ceil(period / (0.5 * kDx / c0)));
-  CaseSetup<1> c = b.build();
+  CaseSetup<1> c = test::simple_scheme(b.build());
   c.simple_weight = weight;
   Simulation<1> sim(c);
   const double v0 = 1e-4 * c0;  // a strain of 1e-4: small deformation

@@ -25,6 +25,16 @@ inline CaseBuilder<2> v2_block(const std::string& name) {
   return b;
 }
 
+/// The thesis's simple scheme for step 2's velocity (solver.velocity_update = "simple",
+/// method-notes §2.3) instead of V2's default hourglass control: the tests of the simple scheme's
+/// own options (its weight, the stress blend and filter) use it.
+template <int Dim>
+inline CaseSetup<Dim> simple_scheme(CaseSetup<Dim> c) {
+  c.simple_velocity = true;
+  c.hourglass = false;
+  return c;
+}
+
 /// +1 / -1 on the two colours of the test block's 0.1 m node lattice (positions from -1 m): the
 /// nodal checkerboard, which no stress point of the lattice sees.
 inline std::vector<double> lattice_checkerboard(const std::vector<Vec<2>>& position) {
