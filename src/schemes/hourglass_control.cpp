@@ -98,8 +98,11 @@ void HourglassControl<Dim>::apply(double dt, const Relation<Dim>& neighbours, Fi
         for (int d = 0; d < Dim; ++d) divergence += a.L[d][d];
         const double compression = -h * divergence / c_i;
         // Below a tenth of the threshold, nothing: the round-off of a linear field stays exact.
-        const double w = std::max(std::clamp((mismatch / kMismatchMach - 0.1) / 0.9, 0.0, 1.0),
-                                  std::clamp(compression / kCompressionMach - 1.0, 0.0, 1.0));
+        // A surface node whose row is regularised or degenerate, wholly (as the weighted simple
+        // scheme of eq. (2.3.2) did there): V1's step 2 lets such lone nodes run away.
+        const double w = a.irregular ? 1.0
+                                     : std::max(std::clamp((mismatch / kMismatchMach - 0.1) / 0.9, 0.0, 1.0),
+                                                std::clamp(compression / kCompressionMach - 1.0, 0.0, 1.0));
         for (int d = 0; d < Dim; ++d) {
           const double ad = (V_i > 0.0 ? f[d] / mass_i : 0.0) + (dt > 0.0 ? w * a.vs[d] / dt : 0.0);
           accel[iu * Dim + static_cast<std::size_t>(d)] = ad;

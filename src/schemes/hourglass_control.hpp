@@ -43,11 +43,17 @@ class HourglassControl {
   /// Node i's state of the step, from step 2: its position and velocity at t^n, its velocity
   /// after the Taylor–Galerkin update and the simple scheme's, the step's velocity gradient L
   /// (grad_v[d][k] = dv_k/dx_d), its stress σ̃ = R σ^n + ½ Δt σ̇ and the stress gradient
-  /// (grad_s[d][c] = dσ_c/dx_d), of which the pass keeps the mean parts.
+  /// (grad_s[d][c] = dσ_c/dx_d), of which the pass keeps the mean parts. `irregular`: the node is
+  /// on the free surface and its row from the stress points was regularised by the gradient floor
+  /// or is degenerate (a lone node squeezed out of the surface): its gradients are not exact, the
+  /// mode-selective terms are not either, and it takes the simple scheme's velocity (eq. (2.6.4),
+  /// w = 1).
   void record(Index i, const Vec<Dim>& x_n, const double* v_n, const double* v_star, const double* v_simple,
-              const double (&grad_v)[Dim][Dim], const double* sigma_tilde, const double (&grad_s)[Dim][NS]) {
+              const double (&grad_v)[Dim][Dim], const double* sigma_tilde, const double (&grad_s)[Dim][NS],
+              bool irregular) {
     const auto u = static_cast<std::size_t>(i);
     Node& n = nodes_[u];
+    n.irregular = irregular;
     for (int d = 0; d < Dim; ++d) {
       n.x[d] = x_n[d];
       n.v[d] = 0.5 * (v_n[d] + v_star[d]);
@@ -88,6 +94,7 @@ class HourglassControl {
     double mean;     // σ̃_m
     double gm[Dim];  // its gradient
     double vs[Dim];  // the simple scheme's velocity minus the Taylor–Galerkin one
+    bool irregular;  // a surface node, its row regularised or degenerate: the simple scheme's velocity
   };
 
   StaggeredModel<Dim>& m_;

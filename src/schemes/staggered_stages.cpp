@@ -603,7 +603,11 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
         for (int k = 0; k < NS; ++k) s_tilde[k] = s[k] + 0.5 * dt * dsig[k];
         double v_simple[Dim];
         for (int d = 0; d < Dim; ++d) v_simple[d] = damped_velocity(v_half[d], dv[d] + b[d], cd, 0.5 * dt);
-        hourglass->record(i, nodes.position[iu], v_n, v, v_simple, grad_v, s_tilde, grad_s);
+        // A lone node on the free surface (its row regularised or degenerate) takes the simple
+        // scheme's velocity (eq. (2.6.4)): a smooth footing's edge squeezes such nodes out.
+        const bool on_surface = !m_.surface.row.empty() && m_.surface.row[iu] >= 0;
+        hourglass->record(i, nodes.position[iu], v_n, v, v_simple, grad_v, s_tilde, grad_s,
+                          irregular_row && on_surface);
       }
       continuity_and_move<Dim>(nodes, iu, grad_v, dt, v_half);
     }
@@ -688,7 +692,8 @@ void NodeFullStep<Dim, Motion, Velocity>::run(const StepContext& c) {
           // The stress points' stress at t^{n+1/2} at the node (eq. (2.3.3); unused at weight 0).
           double s_half[NS];
           for (int k = 0; k < NS; ++k) s_half[k] = acc_s[0][ss + static_cast<std::size_t>(k)];
-          update(i, grad_v, grad_s, v_half, Velocity::kSimple && simple_weight < 1.0 && op.irregular(i), s_half);
+          update(i, grad_v, grad_s, v_half,
+                 (hourglass != nullptr || (Velocity::kSimple && simple_weight < 1.0)) && op.irregular(i), s_half);
         }
       },
       exec::Schedule::even, nodes.size());

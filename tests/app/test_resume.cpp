@@ -398,11 +398,14 @@ TEST(Resume, V2ParticlesTableCountsTheReseedings) {
 }
 
 // Node shifting every 5 steps (its counters in the checkpoint; the shifted positions are the
-// nodes' state).
+// nodes' state). Under the simple scheme: with the default hourglass step this shifted column
+// goes unstable at 0.97 s (an open deviation, docs/VALIDATION.md "V2's default step"); what is
+// tested here is the resume.
 TEST(Resume, V2WithShiftedNodesResumesBitForBit) {
   std::string text = kV2;
   const std::string key = "version = \"v2\"";
-  text.replace(text.find(key), key.size(), key + "\nshift = \"periodic\"\nshift_interval = 5");
+  text.replace(text.find(key), key.size(),
+               key + "\nvelocity_update = \"simple\"\nshift = \"periodic\"\nshift_interval = 5");
   interrupt_and_resume(text.c_str(), SIGTERM, 2, 15);
 }
 
