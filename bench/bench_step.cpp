@@ -8,8 +8,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <ctime>
 #include <limits>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -17,7 +20,13 @@
 
 #include "case/case_builder.hpp"
 #include "linear_solvers/pore_pressure.hpp"
+#include "materials/hardening.hpp"
+#include "materials/lode_form.hpp"
+#include "materials/perzyna.hpp"
 #include "materials/perzyna_models.hpp"
+#include "materials/yield_cam_clay.hpp"
+#include "materials/yield_drucker_prager.hpp"
+#include "materials/yield_mohr_coulomb.hpp"
 #include "operators/corrected_operator.hpp"
 #include "particles/reseed.hpp"
 #include "schemes/pressure_stage.hpp"
@@ -586,5 +595,138 @@ void plastic_block_arguments(benchmark::internal::Benchmark* b) {
   }
 }
 BENCHMARK(BM_PlasticBlock)->Apply(plastic_block_arguments)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// ---- one backward-Euler return (method-notes §2.5)
+
+// Trial stresses just beyond the surface, as a stiff step brings them: a frictional soil
+// (E = 50 MPa, c = 200 Pa, phi = 30 deg, psi = 0, gamma = 100 1/s, tau = 2.5e-4 s: a column
+// 4 m high at its time step, method-notes §2.5) at p' = 1-80 kPa, or Cam-Clay (p_c = 200 kPa) at
+// p' = 0.2-0.95 p_c; Lode angles over the whole range, principal axes turned, the overstress
+// 0.1 %-30 % (of Mohr–Coulomb, and at least as much of the plane-strain Drucker–Prager cone,
+// which is Mohr–Coulomb with K = 1).
+struct ReturnTrials {
+  std::vector<Sym6> stress;
+  double tau = 2.5e-4;
+};
+
+Sym6 principal_turned(double p, double q, double theta, double turn) {
+  const double d[3] = {2.0 * q / 3.0 * std::sin(theta + 2.0 * std::numbers::pi / 3.0), 2.0 * q / 3.0 * std::sin(theta),
+                       2.0 * q / 3.0 * std::sin(theta - 2.0 * std::numbers::pi / 3.0)};
+  const double c = std::cos(turn), s = std::sin(turn), cx = std::cos(0.7 * turn), sx = std::sin(0.7 * turn);
+  const double R[3][3] = {{c, -s * cx, s * sx}, {s, c * cx, -c * sx}, {0.0, sx, cx}};
+  double m[3][3];
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      m[i][j] = 0.0;
+      for (int k = 0; k < 3; ++k) m[i][j] += R[i][k] * d[k] * R[j][k];
+    }
+  }
+  return {m[0][0] - p, m[1][1] - p, m[2][2] - p, m[0][1], m[1][2], m[0][2]};
+}
+
+ReturnTrials return_trials(bool cam_clay, std::size_t count) {
+  ReturnTrials t;
+  std::uint64_t seed = 12345;
+  auto uniform = [&seed] {  // a 64-bit LCG: the same trials on every machine
+    seed = seed * 6364136223846793005ULL + 1442695040888963407ULL;
+    return static_cast<double>(seed >> 11) * 0x1.0p-53;
+  };
+  const double deg = std::numbers::pi / 180.0;
+  const MohrCoulombSurface mc = MohrCoulombSurface::make(30.0 * deg, 0.0, 0.1);
+  const double Y = std::sqrt(3.0) * std::cos(30.0 * deg) * 200.0, pc = 2.0e5, M = 1.2;
+  for (std::size_t i = 0; i < count; ++i) {
+    const double theta = (uniform() - 0.5) * 60.0 * deg, turn = 3.0 * uniform();
+    const double over = 1.0 + 0.001 * std::pow(300.0, uniform());
+    double p = 0.0, q = 0.0;
+    if (cam_clay) {
+      p = (0.2 + 0.75 * uniform()) * pc;
+      const double sphi = 3.0 * M / (6.0 + M);  // M(theta) of method-notes eq. (1.8.4)
+      q = over * 6.0 * sphi / (3.0 - sphi * std::sin(3.0 * theta)) * std::sqrt(p * (pc - p));
+    } else {
+      p = 1e3 + 7.9e4 * uniform();
+      const double K = std::min(mc.lode_F.along(LodeAngle::of(theta)).K, 1.0), dF = mc.round_F * Y;
+      const double R = Y + std::sqrt(3.0) * 0.5 * p;
+      q = over * std::sqrt(R * R - dF * dF) / K;
+    }
+    t.stress.push_back(principal_turned(p, q, theta, turn));
+  }
+  return t;
+}
+
+template <class Model>
+void time_returns(benchmark::State& state, const Model& model, typename detail::PerzynaBackwardEuler<Model>::Path path,
+                  const ReturnTrials& trials, const std::vector<double>& k0) {
+  const detail::PerzynaBackwardEuler<Model> solver(model, path);
+  Sym6 sigma;
+  double k[4];
+  long returns = 0, iterations = 0, failed = 0;
+  // This thread's CPU time: on a shared machine the wall clock counts the neighbours' work too.
+  auto cpu_seconds = [] {
+    timespec t{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+  };
+  const double t0 = cpu_seconds();
+  for (auto _ : state) {
+    for (const Sym6& trial : trials.stress) {
+      const ImplicitOutcome o = solver.solve(trial, k0.data(), trials.tau, sigma, k);
+      benchmark::DoNotOptimize(sigma);
+      iterations += o.iterations;
+      failed += o.converged ? 0 : 1;
+      ++returns;
+    }
+  }
+  const double seconds = cpu_seconds() - t0;
+  state.counters["ns/return"] = seconds / static_cast<double>(returns) * 1e9;
+  state.counters["newton/return"] = static_cast<double>(iterations) / static_cast<double>(returns);
+  state.counters["failed"] = static_cast<double>(failed);
+}
+
+// Models: 0 Drucker–Prager ((p', q) return), 1 Mohr–Coulomb with the generic (mean, a, b)
+// return and forward differences, 2 Mohr–Coulomb with the (p', q, theta) return, 3 and 4 the
+// same two for Cam-Clay with M(theta).
+void BM_ImplicitReturn(benchmark::State& state) {
+  const int model = static_cast<int>(state.range(0));
+  const double deg = std::numbers::pi / 180.0;
+  const ElasticConstants el = ElasticConstants::from_E_nu(5.0e7, 0.3, 2000.0);
+  const ReturnTrials trials = return_trials(model >= 3, 4096);
+  if (model == 0) {
+    DruckerPragerParameters p;
+    p.elastic = el;
+    p.cohesion = 200.0;
+    p.friction_angle = 30.0 * deg;
+    p.fluidity = 100.0;
+    const auto m = make_perzyna_drucker_prager(p);
+    using Model = PerzynaMaterial<DruckerPragerSurface, LinearHardening>;
+    time_returns(state, dynamic_cast<const Model&>(*m), detail::PerzynaBackwardEuler<Model>::Path::fastest, trials,
+                 {0.0});
+  } else if (model <= 2) {
+    MohrCoulombParameters p;
+    p.elastic = el;
+    p.cohesion = 200.0;
+    p.friction_angle = 30.0 * deg;
+    p.fluidity = 100.0;
+    const auto m = make_perzyna_mohr_coulomb(p);
+    using Model = PerzynaMaterial<MohrCoulombSurface, LinearHardening>;
+    using Path = detail::PerzynaBackwardEuler<Model>::Path;
+    time_returns(state, dynamic_cast<const Model&>(*m), model == 1 ? Path::generic : Path::fastest, trials, {0.0});
+  } else {
+    CamClayParameters p;
+    p.elastic = el;
+    p.M = 1.2;
+    p.lode_dependent_M = true;
+    p.lambda = 0.2;
+    p.kappa = 0.02;
+    p.e0 = 1.0;
+    p.p_c0 = 2.0e5;
+    p.fluidity = 100.0;
+    const auto m = make_perzyna_cam_clay(p);
+    using Model = PerzynaMaterial<CamClaySurface, CamClayHardening>;
+    using Path = detail::PerzynaBackwardEuler<Model>::Path;
+    time_returns(state, dynamic_cast<const Model&>(*m), model == 3 ? Path::generic : Path::fastest, trials,
+                 {0.0, 0.0, 2.0e5});
+  }
+}
+BENCHMARK(BM_ImplicitReturn)->DenseRange(0, 4)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 BENCHMARK_MAIN();

@@ -9,8 +9,9 @@
 // the rate-independent return mapping (x = dead band). Every surface here is an isotropic
 // function and the elasticity is isotropic, so sigma stays coaxial with sigma_tr: the unknowns
 // are the mean stress, the deviator's components on s_tr and (for Lode-dependent surfaces) on
-// dev(s_tr^2), the history variable that sets Y, and the multipliers (eq. 2.5.3). Newton with a
-// forward-difference Jacobian in those few coordinates (the multiplier columns exact), a
+// dev(s_tr^2), the history variable that sets Y, and the multipliers (eq. 2.5.3). Newton with
+// the exact Jacobian of each surface's (p', q) or (p', q, theta) form (eqs. (2.5.8)–(2.5.16)), or
+// with forward differences in the generic problem (the reference, and the fall-back), a
 // backtracking line search, an active set for the two mechanisms, and halving of the interval
 // when Newton fails: a few iterations whatever gamma and the cohesion.
 #include <algorithm>
@@ -21,6 +22,7 @@
 #include <utility>
 
 #include "core/types.hpp"
+#include "materials/lode_form.hpp"
 #include "materials/material.hpp"
 #include "materials/overstress.hpp"
 #include "materials/pq_form.hpp"
@@ -74,8 +76,18 @@ class PerzynaBackwardEuler {
   static constexpr double kTolerance = 1e-12;  // scaled residual, infinity norm
   static constexpr double kRoundOffTolerance = 1e-9;  // accepted where Newton stalls on round-off
   static constexpr double kAddTolerance = 1e-9;  // overstress that brings a mechanism back
+  // Where the apex flow is evaluated, as a fraction of the trial scale.
+  static constexpr double kApexOffset = 1e-6;
+  static constexpr double kRoot32 = 1.2247448713915890491;   // sqrt(3/2): q = sqrt(3/2) |s|
+  static constexpr double kRoot23 = 0.81649658092772603273;  // sqrt(2/3)
 
-  explicit PerzynaBackwardEuler(const Model& model) : model_(model) {}
+  /// Which reduced problem solve() uses: the fastest the surface allows ((p', q) or (p', q,
+  /// theta) with the exact Jacobian, the latter falling back on the generic one where it fails),
+  /// the same without that fall-back (for the tests), or the generic (mean, a, b) one with
+  /// forward differences, the reference of the tests and the benchmark.
+  enum class Path { fastest, exact_only, generic };
+
+  explicit PerzynaBackwardEuler(const Model& model, Path path = Path::fastest) : model_(model), path_(path) {}
 
   /// Integrate from the trial state (sigma_tr, k0) over tau; sigma and k receive the end state.
   /// On failure (no convergence) sigma and k are left at the trial state and converged = false.
@@ -86,23 +98,45 @@ class PerzynaBackwardEuler {
     sigma = sigma_tr;
     for (int j = 0; j < kStates; ++j) k[j] = k0[j];
     const double Y0 = hard.size(k0);
-    const double x_tr = model_.surface().value(sigma_tr, Y0) / Y0 - 1.0;
     const double xt_tr = cut.active ? cut.overstress(sigma_tr, Y0) : -1.0;
-    bool shear = x_tr > phi.dead_band;
-    bool tension = cut.active && xt_tr > phi.dead_band;
+    const bool tension = cut.active && xt_tr > phi.dead_band;
     ImplicitOutcome out;
+    if (path_ != Path::generic) {
+      if constexpr (requires(const Surface& s) { s.pq_theta(0.0, 0.0, LodeAngle{}, 1.0); }) {
+        if (model_.surface().lode_depends()) {
+          // The trial's overstress from the form, the invariants it has computed anyway.
+          LodeProblem pb(model_, sigma_tr, k0, tau);
+          const bool shear = pb.trial_overstress() > phi.dead_band;
+          if (!shear && !tension) {
+            out.converged = true;
+            return out;
+          }
+          out = active_set(pb, shear, tension, sigma, k);
+          if (out.converged || path_ == Path::exact_only) return out;
+          // A trial far outside (10^3 times the strength) can have several Lode angles whose
+          // flow points back at it, and Newton on these coordinates may stall between them:
+          // the generic problem's path then (method-notes §2.5, "(p', q, theta) form").
+        }
+      }
+    }
+    const bool shear = model_.surface().value(sigma_tr, Y0) / Y0 - 1.0 > phi.dead_band;
     if (!shear && !tension) {
       out.converged = true;
       return out;
     }
-    if constexpr (requires(const Surface& s) { s.pq(0.0, 0.0, 1.0); }) {
-      if (!model_.surface().lode_depends()) {
-        PQProblem pb(model_, sigma_tr, k0, tau);
-        return active_set(pb, shear, tension, sigma, k);
+    if (path_ != Path::generic) {
+      if constexpr (requires(const Surface& s) { s.pq(0.0, 0.0, 1.0); }) {
+        if (!model_.surface().lode_depends()) {
+          PQProblem pb(model_, sigma_tr, k0, tau);
+          return active_set(pb, shear, tension, sigma, k);
+        }
       }
     }
     Problem pb(model_, sigma_tr, k0, tau);
-    return active_set(pb, shear, tension, sigma, k);
+    const int tried = out.iterations;
+    out = active_set(pb, shear, tension, sigma, k);
+    out.iterations += tried;
+    return out;
   }
 
  private:
@@ -219,6 +253,56 @@ class PerzynaBackwardEuler {
       if (!std::isfinite(x[i])) return false;
     }
     return true;
+  }
+
+  // solve_negated_in_place with the size known at compile time: unrolled, and the pivots'
+  // reciprocals reused by the back-substitution (the Lode problem's few unknowns; its results
+  // differ from the general routine's in the last bits only).
+  template <int N>
+  static bool solve_fixed(Matrix& J, Vector& r, Vector& x) {
+    double inv_pivot[N];
+    for (int c = 0; c < N; ++c) {
+      int piv = c;
+      for (int i = c + 1; i < N; ++i) {
+        if (std::abs(J(i, c)) > std::abs(J(piv, c))) piv = i;
+      }
+      if (!(std::abs(J(piv, c)) > 0.0)) return false;
+      if (piv != c) {
+        for (int j = c; j < N; ++j) std::swap(J(c, j), J(piv, j));
+        std::swap(r[c], r[piv]);
+      }
+      inv_pivot[c] = 1.0 / J(c, c);
+      for (int i = c + 1; i < N; ++i) {
+        const double f = J(i, c) * inv_pivot[c];
+        for (int j = c + 1; j < N; ++j) J(i, j) -= f * J(c, j);
+        r[i] -= f * r[c];
+      }
+    }
+    x = Vector(N);
+    bool finite = true;
+    for (int i = N - 1; i >= 0; --i) {
+      double sum = -r[i];
+      for (int j = i + 1; j < N; ++j) sum -= J(i, j) * x[j];
+      x[i] = sum * inv_pivot[i];
+      finite = finite && std::isfinite(x[i]);
+    }
+    return finite;
+  }
+  static bool solve_small(Matrix& J, Vector& r, Vector& x) {
+    switch (r.size()) {
+      case 2:
+        return solve_fixed<2>(J, r, x);
+      case 3:
+        return solve_fixed<3>(J, r, x);
+      case 4:
+        return solve_fixed<4>(J, r, x);
+      case 5:
+        return solve_fixed<5>(J, r, x);
+      case 6:
+        return solve_fixed<6>(J, r, x);
+      default:
+        return solve_negated_in_place(J, r, x);
+    }
   }
 
   // The reduced problem of one trial state (eq. 2.5.3). Unknowns, in order: the mean stress,
@@ -514,9 +598,6 @@ class PerzynaBackwardEuler {
       return J;
     }
 
-    // Where the apex flow is evaluated, as a fraction of the trial scale.
-    static constexpr double kApexOffset = 1e-6;
-
     const Model& model_;
     OverstressInverse inverse_;
     double k0_[kStates];
@@ -798,7 +879,479 @@ class PerzynaBackwardEuler {
     double p_ = 0.0, q_ = 0.0, kd_ = 0.0;
   };
 
+  // The return of a Lode-dependent surface with its exact Jacobian (method-notes eqs.
+  // (2.5.11)–(2.5.16)): the deviator sqrt(2/3) (q_a e1 + q_b e2) in the coaxial plane of
+  // eq. (2.5.3), q_a = q cos b and q_b = q sin b, of Lode angle theta_tr - b; F and the flow from
+  // the surface's (p', q, theta) form. Unknowns p', q_a and q_b (unless the trial is hydrostatic
+  // or the deviator is held at the apex; q_b off the triaxial corners only), the driver of Y and
+  // the active multipliers; rows those of the generic problem (the p' equation, the deviator's
+  // on e1 and e2, the driver, the consistency conditions; at the apex the row on e1 replaces
+  // the shear one). Cartesian q_a, q_b rather than (q, b): the rows stay nearly linear (exactly,
+  // on a Mohr–Coulomb face), and Newton converges from trials far outside as the generic one does.
+  class LodeProblem {
+   public:
+    LodeProblem(const Model& model, const Sym6& sigma_tr, const double* k0, double tau)
+        : model_(model), inverse_{model.overstress(), model.fluidity() * tau} {
+      for (int j = 0; j < kStates; ++j) k0_[j] = k0[j];
+      const double mean_tr = tensor::trace(sigma_tr) / 3.0;
+      const Sym6 s = tensor::deviator(sigma_tr);
+      const double ns = std::sqrt(tensor::ddot(s, s));
+      p_tr_ = -mean_tr;
+      scale_ = std::max({model.hardening().size(k0), ns, std::abs(mean_tr)});
+      inv_scale_ = 1.0 / scale_;
+      q_apex_ = kRoot32 * kApexOffset * scale_;
+      plane_ = CoaxialPlane::of(s, 1e-13 * scale_);
+      has_q_ = plane_.has_e1;
+      has_b_ = plane_.has_e2;
+      if (has_q_) q_tr_ = kRoot32 * ns;
+      const double c30 = std::sqrt(3.0) / 2.0, c = plane_.cos_theta, sn = plane_.sin_theta;
+      corners_[0] = {c * c30 + sn * 0.5, sn * c30 - c * 0.5};  // b = theta_tr - pi/6
+      corners_[1] = {c * c30 - sn * 0.5, sn * c30 + c * 0.5};  // b = theta_tr + pi/6
+      p_ = p_tr_;
+      qa_ = q_tr_;
+      kd_ = k0_[Hardening::kDriver];
+      const PressureDependentModuli& pm = model.pressure_moduli();
+      if (!pm.active()) {
+        K_ = model.elastic().K;
+        G_ = model.elastic().G;
+      }
+    }
+
+    double dl = 0.0, dl_t = 0.0;
+
+    /// The trial's overstress F/Y - 1 from the form (the surface's value() in invariants).
+    double trial_overstress() {
+      trial_form_ = model_.surface().pq_theta(p_tr_, q_tr_, plane_.lode_angle(1.0, 0.0).lode, size());
+      has_trial_form_ = true;
+      return trial_form_.F / size() - 1.0;
+    }
+    /// A hydrostatic trial whose potential has no volumetric part: no shear flow (eq. (2.5.5)).
+    bool shear_inert() const {
+      if (has_q_) return false;
+      const double Qp = model_.surface().pq_theta(p_, 0.0, LodeAngle{}, size()).Q_p;
+      return std::abs(Qp) <= 1e-12 * (1.0 + std::abs(Qp) / std::sqrt(3.0));  // |tr m| against |m|
+    }
+    bool at_apex() const { return apex_; }
+    bool apex_inside() const {
+      const double Y = size();
+      return model_.surface().pq_theta(p_, 0.0, LodeAngle{}, Y).F / Y - 1.0 < inverse_.value(dl) - 1e-9;
+    }
+    void forbid_apex() {
+      allow_apex_ = false;
+      apex_ = false;
+      p_ = p_tr_;
+      qa_ = q_tr_;
+      qb_ = 0.0;
+      kd_ = k0_[Hardening::kDriver];
+      dl = dl_t = 0.0;
+    }
+    double size() const { return model_.hardening().size_of(kd_); }
+    Sym6 sigma() const {
+      Sym6 s{};
+      const double a = kRoot23 * qa_, b = kRoot23 * qb_;
+      for (std::size_t i = 0; i < 6; ++i) s[i] = a * plane_.e1[i] + b * plane_.e2[i];
+      for (std::size_t i = 0; i < 3; ++i) s[i] -= p_;
+      return s;
+    }
+
+    ImplicitOutcome newton(bool shear, bool tension) {
+      shear_ = shear;
+      tension_ = tension;
+      apex_ = false;
+      if (!shear_) dl = 0.0;
+      if (!tension_) dl_t = 0.0;
+      if (shear_ && dl <= 0.0) {
+        // A linearised guess (eq. 2.5.5), dF/dsigma : D^e : m in these coordinates, and the
+        // driver it gives.
+        const double Y = size();
+        const Polar at = polar(qa_, qb_);
+        // At the trial (the first pass) the form is that of trial_overstress().
+        const bool at_trial =
+            has_trial_form_ && p_ == p_tr_ && qa_ == q_tr_ && qb_ == 0.0 && kd_ == k0_[Hardening::kDriver];
+        const LodeForm f = at_trial ? trial_form_ : model_.surface().pq_theta(p_, at.q, at.angle.lode, Y);
+        const Flow m = flow(p_, at.q, at.angle, Y, &f);
+        const double F_b_over_q = at.q > 0.0 ? -at.angle.sign * f.F_theta / at.q : 0.0;
+        const double stiff = std::abs(f.F_p * K() * m.Qp + 3.0 * G() * (f.F_q * m.Qq + F_b_over_q * m.V)) / Y;
+        const double soft = std::isinf(inverse_.gamma_tau) ? 0.0 : 1.0 / inverse_.gamma_tau;
+        dl = std::max(0.0, f.F / Y - 1.0 - model_.overstress().dead_band) / std::max(stiff + soft, 1e-300);
+        kd_ = model_.hardening().driver_end(k0_[Hardening::kDriver], dl, m.Qp, m.Qd, dl_t).value;
+      }
+      state_scale_ = std::max({std::abs(k0_[Hardening::kDriver]), std::abs(kd_), Hardening::kDriverScale});
+      inv_state_scale_ = 1.0 / state_scale_;
+      ImplicitOutcome out;
+      int corner_stops = 0;
+      Vector z = unknowns();
+      Point here, there;  // the rows' ingredients at z and at the line search's trial point
+      Point* at = &here;
+      Point* at_new = &there;
+      Matrix J;
+      Vector r = evaluate(z, *at);
+      for (int it = 0; it < kMaxIterations; ++it) {
+        if (r.norm_inf() <= kTolerance) {
+          end_Qp_ = at->m.Qp;
+          end_Qd_ = at->m.Qd;
+          out.converged = true;
+          return out;
+        }
+        ++out.iterations;
+        jacobian(*at, J);
+        Vector dz, rr = r;
+        const double merit = r.squared_norm();
+        const bool solved = solve_small(J, rr, dz);
+        // Newton drives the deviator through the axis (q_a < 0), or it already sits clamped there.
+        const bool at_axis = q_free() && shear_ && allow_apex_ && (z[1] == 0.0 || (solved && z[1] + dz[1] < 0.0));
+        if (!solved && !at_axis) return out;
+        // A step that carries the Lode angle through a triaxial corner ends there (eq. (2.5.16)):
+        // the flow's part normal to s vanishes at the corner and turns within its rounding, so
+        // Newton from a face would jump to the other face and back.
+        if (solved && !at_axis && b_free() && shear_ && corner_stops < kMaxCornerStops &&
+            model_.surface().sharp_corners()) {
+          const double to_corner = corner_crossing(z, dz);
+          if (to_corner < 1.0) {
+            ++corner_stops;
+            for (int i = 0; i < z.size(); ++i) z[i] += to_corner * dz[i];
+            set(z);
+            r = evaluate(z, *at);
+            continue;
+          }
+        }
+        double alpha = 1.0;
+        Vector z_new = z;
+        Vector r_new;
+        bool decreased = false;
+        for (int ls = 0; ls < 12 && solved && !decreased; ++ls) {
+          for (int i = 0; i < z.size(); ++i) z_new[i] = z[i] + alpha * dz[i];
+          if (q_free() && z_new[1] < 0.0) {  // q_a >= 0: a flip through the axis is not a return
+            z_new[1] = 0.0;
+            if (has_b_) z_new[2] = 0.0;
+          }
+          r_new = evaluate(z_new, *at_new);
+          const double m = r_new.squared_norm();
+          decreased = std::isfinite(m) && m < (1.0 - 1e-4 * alpha) * merit;
+          if (!decreased) alpha *= 0.5;
+        }
+        if (!decreased && at_axis) {
+          // Newton drives the deviator through zero and no shorter step helps: the apex
+          // (eq. 2.5.5), the flow's limit along the trial's deviator.
+          apex_ = true;
+          qa_ = qb_ = 0.0;
+          z = unknowns();
+          r = evaluate(z, *at);
+          continue;
+        }
+        if (!decreased) {
+          out.converged = r.norm_inf() <= kRoundOffTolerance;
+          end_Qp_ = at->m.Qp;
+          end_Qd_ = at->m.Qd;
+          return out;
+        }
+        z = z_new;
+        r = r_new;
+        std::swap(at, at_new);
+        set(z);
+      }
+      out.converged = r.norm_inf() <= kTolerance;
+      end_Qp_ = at->m.Qp;
+      end_Qd_ = at->m.Qd;
+      return out;
+    }
+
+    void finish(Sym6& sigma_out, double* k) const {
+      sigma_out = sigma();
+      // The full history from the plastic strain dl m + dl_t/3 1 (eq. 2.5.1): its deviatoric
+      // equivalent is dl sqrt(Q_q^2 + V^2), its volume -dl Q_p + dl_t (eq. (2.5.14)).
+      model_.hardening().pq_states(k0_, shear_ ? dl : 0.0, end_Qp_, end_Qd_, tension_ ? dl_t : 0.0, k);
+      k[Hardening::kDriver] = kd_;
+    }
+
+   private:
+    static constexpr int kMaxCornerStops = 2;  // a Newton solve's stops at the corners
+
+    double K() const { return K_ > 0.0 ? K_ : model_.pressure_moduli().bulk_modulus(p_); }
+    double G() const { return G_ > 0.0 ? G_ : model_.pressure_moduli().shear_modulus(K()); }
+
+    bool q_free() const { return has_q_ && !apex_; }
+    bool b_free() const { return q_free() && has_b_; }
+    int count() const { return 2 + (q_free() ? 1 : 0) + (b_free() ? 1 : 0) + (shear_ ? 1 : 0) + (tension_ ? 1 : 0); }
+    Vector unknowns() const {
+      Vector z(count());
+      int i = 0;
+      z[i++] = p_;
+      if (q_free()) z[i++] = qa_;
+      if (b_free()) z[i++] = qb_;
+      z[i++] = kd_;
+      if (shear_) z[i++] = dl;
+      if (tension_) z[i++] = dl_t;
+      return z;
+    }
+    void set(const Vector& z) {
+      int i = 0;
+      p_ = z[i++];
+      if (q_free()) qa_ = z[i++];
+      if (b_free()) qb_ = z[i++];
+      kd_ = z[i++];
+      if (shear_) dl = z[i++];
+      if (tension_) dl_t = z[i++];
+    }
+
+    // The fraction of the step dz at which the deviator crosses a triaxial corner's ray in the
+    // plane (theta_tr - b = +-pi/6), or 1 (eq. (2.5.16)).
+    double corner_crossing(const Vector& z, const Vector& dz) const {
+      double fraction = 1.0;
+      for (const Ray& c : corners_) {
+        const double side0 = z[1] * c.sin - z[2] * c.cos;
+        const double side1 = (z[1] + dz[1]) * c.sin - (z[2] + dz[2]) * c.cos;
+        if (!(side0 * side1 < 0.0)) continue;
+        const double t = side0 / (side0 - side1);
+        // On the ray itself, not its opposite; from a start at the corner, no stop.
+        if (t > 1e-6 && (z[1] + t * dz[1]) * c.cos + (z[2] + t * dz[2]) * c.sin > 0.0) fraction = std::min(fraction, t);
+      }
+      return fraction;
+    }
+
+    // q, cos b, sin b and the Lode angle theta_tr - b of the deviator (q_a, q_b) (eq. (2.5.11)).
+    struct Polar {
+      double q, cb, sb;
+      FoldedLodeAngle angle;
+    };
+    Polar polar(double qa, double qb) const {
+      const double q = std::sqrt(qa * qa + qb * qb);
+      if (!(q > 0.0)) return {0.0, 1.0, 0.0, plane_.lode_angle(1.0, 0.0)};
+      const double inv = 1.0 / q;
+      const double cb = qa * inv, sb = qb * inv;
+      return {q, cb, sb, plane_.lode_angle(cb, sb)};
+    }
+
+    // The flow's components at (p', q, b) and their derivatives (eq. (2.5.13)), along p', q, b
+    // and Y: Q_p, Q_q, V = Q_b/q (the part normal to s per unit q; Q_b = -dQ/dtheta) and
+    // Q_d = sqrt(Q_q^2 + V^2) (the equivalent strain per unit dl). Zero where the mechanism
+    // does not act; no deviatoric part for a hydrostatic trial. The flow is taken at q, at the
+    // apex offset at least (as the generic problem's, eq. (2.5.5)); f is the form at q.
+    struct Flow {
+      double Qp = 0.0, Qp_p = 0.0, Qp_q = 0.0, Qp_b = 0.0, Qp_Y = 0.0;
+      double Qq = 0.0, Qq_p = 0.0, Qq_q = 0.0, Qq_b = 0.0, Qq_Y = 0.0;
+      double V = 0.0, V_p = 0.0, V_q = 0.0, V_b = 0.0, V_Y = 0.0;
+      double Qd = 0.0, Qd_p = 0.0, Qd_q = 0.0, Qd_b = 0.0, Qd_Y = 0.0;
+    };
+    Flow flow(double p, double q, const FoldedLodeAngle& angle, double Y, const LodeForm* f = nullptr) const {
+      Flow m;
+      if (!shear_) return m;
+      const double qf = has_q_ ? std::max(q, q_apex_) : 0.0;
+      const bool along_q = has_q_ && q > q_apex_;  // the flow varies with q
+      LodeForm at_qf;
+      const LodeForm* form = f;
+      if (form == nullptr || qf != q) {
+        at_qf = model_.surface().pq_theta(p, qf, angle.lode, Y);
+        form = &at_qf;
+      }
+      const LodeForm& g = *form;
+      const double to_b = -angle.sign;  // dtheta/db through the fold
+      m.Qp = g.Q_p;
+      m.Qp_p = g.Q_pp;
+      m.Qp_q = along_q ? g.Q_pq : 0.0;
+      m.Qp_b = to_b * g.Q_ptheta;
+      m.Qp_Y = g.Q_pY;
+      if (!has_q_) return m;
+      const double inv_q = 1.0 / qf;
+      m.Qq = g.Q_q;
+      m.Qq_p = g.Q_pq;
+      m.Qq_q = along_q ? g.Q_qq : 0.0;
+      m.Qq_b = to_b * g.Q_qtheta;
+      m.Qq_Y = g.Q_qY;
+      m.V = to_b * g.Q_theta * inv_q;
+      m.V_p = to_b * g.Q_ptheta * inv_q;
+      m.V_q = along_q ? (to_b * g.Q_qtheta - m.V) * inv_q : 0.0;
+      m.V_b = g.Q_thetatheta * inv_q;
+      m.V_Y = to_b * g.Q_thetaY * inv_q;
+      m.Qd = std::sqrt(m.Qq * m.Qq + m.V * m.V);
+      if (m.Qd > 0.0) {
+        const double inv = 1.0 / m.Qd;
+        m.Qd_p = (m.Qq * m.Qq_p + m.V * m.V_p) * inv;
+        m.Qd_q = (m.Qq * m.Qq_q + m.V * m.V_q) * inv;
+        m.Qd_b = (m.Qq * m.Qq_b + m.V * m.V_b) * inv;
+        m.Qd_Y = (m.Qq * m.Qq_Y + m.V * m.V_Y) * inv;
+      }
+      return m;
+    }
+
+    // What the rows are made of at one iterate: the Jacobian is built from it only where Newton
+    // steps from that iterate (not at the line search's rejected points, nor at convergence).
+    struct Point {
+      int n = 0, ia = -1, ib = -1, ik = 0, il = -1, it = -1;
+      double l = 0.0, lt = 0.0, cb = 1.0, sb = 0.0, inv_q = 0.0, Y = 0.0, Yk = 0.0;
+      double G = 0.0, dG_dp = 0.0, dp_dev = 0.0, x = 0.0, x_t = 0.0;
+      double F_p = 0.0, F_q = 0.0, F_b = 0.0, F_Y = 0.0;
+      double d_Qp = 0.0, d_Qd = 0.0, d_dl = 0.0, d_dlt = 0.0;  // the driver's partials
+      Flow m;
+    };
+
+    // Residuals: the generic problem's rows, the deviator's in units of |s| (eq. (2.5.15)).
+    Vector evaluate(const Vector& z, Point& pt) const {
+      int i = 0;
+      pt.n = z.size();
+      const double p = z[i++];
+      pt.ia = q_free() ? i++ : -1;
+      pt.ib = b_free() ? i++ : -1;
+      pt.ik = i++;
+      pt.il = shear_ ? i++ : -1;
+      pt.it = tension_ ? i++ : -1;
+      const double qa = pt.ia >= 0 ? z[pt.ia] : 0.0;
+      const double qb = pt.ib >= 0 ? z[pt.ib] : 0.0;
+      const double kd = z[pt.ik];
+      const double l = pt.il >= 0 ? z[pt.il] : 0.0;
+      const double lt = pt.it >= 0 ? z[pt.it] : 0.0;
+      pt.l = l;
+      pt.lt = lt;
+      const Hardening& hard = model_.hardening();
+      const double Y = hard.size_of(kd);
+      pt.Y = Y;
+      pt.Yk = hard.size_slope(kd);
+      const Polar at = polar(qa, qb);
+      pt.cb = at.cb;
+      pt.sb = at.sb;
+      pt.inv_q = 1.0 / (at.q > 0.0 ? at.q : q_apex_);
+      const LodeForm f = model_.surface().pq_theta(p, at.q, at.angle.lode, Y);
+      pt.m = flow(p, at.q, at.angle, Y, &f);
+      const Flow& m = pt.m;
+      pt.F_p = f.F_p;
+      pt.F_q = f.F_q;
+      pt.F_b = -at.angle.sign * f.F_theta;
+      pt.F_Y = f.F_Y;
+      // The deviatoric flow on e1 and e2 (per sqrt(3/2)): Q_q along s, V normal to it.
+      const double ma = m.Qq * at.cb - m.V * at.sb, mb = m.Qq * at.sb + m.V * at.cb;
+      const double ev = -l * m.Qp + lt;  // plastic volumetric strain, dilation positive
+      // p' after ev: K ev at constant moduli, the exact swelling law with p'-dependent ones.
+      const PressureDependentModuli& pm = model_.pressure_moduli();
+      double p_end = 0.0;
+      if (pm.active()) {
+        p_end = pm.pressure_after_plastic_volume(p_tr_, ev);
+        pt.dp_dev = pm.v0_over_kappa * std::clamp(p_end, pm.p_min, pm.p_max);
+        pt.G = pm.shear_modulus(pm.bulk_modulus(p));
+        const bool inside = p > pm.p_min && p < pm.p_max;
+        pt.dG_dp = pm.constant_shear || !inside ? 0.0 : pm.G_over_K * pm.v0_over_kappa;
+      } else {
+        p_end = p_tr_ + K_ * ev;
+        pt.dp_dev = K_;
+        pt.G = G_;
+      }
+      const auto dEnd = hard.driver_end(k0_[Hardening::kDriver], l, m.Qp, m.Qd, lt);
+      pt.d_Qp = dEnd.d_Qp;
+      pt.d_Qd = dEnd.d_Qq;
+      pt.d_dl = dEnd.d_dl;
+      pt.d_dlt = dEnd.d_dlt;
+      const double s = inv_scale_, ds = kRoot23 * inv_scale_;
+      const double G3l = 3.0 * pt.G * l;
+      Vector r(pt.n);
+      int row = 0;
+      r[row++] = (p - p_end) * s;
+      if (pt.ia >= 0) r[row++] = (qa - q_tr_ + G3l * ma) * ds;
+      if (pt.ib >= 0) r[row++] = (qb + G3l * mb) * ds;
+      r[row++] = (kd - dEnd.value) * inv_state_scale_;
+      if (pt.il >= 0) {
+        pt.x = inverse_.value(l);
+        // At the apex the row on e1 (q_a = q_b = 0) replaces the consistency.
+        r[row++] = apex_ ? (G3l * ma - q_tr_) * ds : (f.F - Y * (1.0 + pt.x)) * s;
+      }
+      if (pt.it >= 0) {
+        pt.x_t = inverse_.value(lt);
+        r[row] = (-p - model_.tension_cutoff().limit - Y * pt.x_t) * s;
+      }
+      return r;
+    }
+
+    // The exact Jacobian of evaluate()'s rows (eq. (2.5.15)): the partials along (p', q, b) of
+    // the form, taken to (q_a, q_b) by d/dq_a = cos b d/dq - (sin b/q) d/db and
+    // d/dq_b = sin b d/dq + (cos b/q) d/db.
+    void jacobian(const Point& pt, Matrix& J) const {
+      J.clear(pt.n);
+      const Flow& m = pt.m;
+      const double cb = pt.cb, sb = pt.sb, inv_q = pt.inv_q, l = pt.l, G = pt.G, Yk = pt.Yk;
+      const int ia = pt.ia, ib = pt.ib, ik = pt.ik, il = pt.il, it = pt.it;
+      auto put = [&J](int row, int c, double v) {
+        if (c >= 0) J(row, c) = v;
+      };
+      auto along_a = [&](double d_q, double d_b) { return cb * d_q - sb * inv_q * d_b; };
+      auto along_b = [&](double d_q, double d_b) { return sb * d_q + cb * inv_q * d_b; };
+      const double s = inv_scale_, ss = inv_state_scale_, ds = kRoot23 * inv_scale_;
+      int row = 0;
+      // p' row
+      put(row, 0, (1.0 + pt.dp_dev * l * m.Qp_p) * s);
+      put(row, ia, pt.dp_dev * l * along_a(m.Qp_q, m.Qp_b) * s);
+      put(row, ib, pt.dp_dev * l * along_b(m.Qp_q, m.Qp_b) * s);
+      put(row, ik, pt.dp_dev * l * m.Qp_Y * Yk * s);
+      put(row, il, pt.dp_dev * m.Qp * s);
+      put(row, it, -pt.dp_dev * s);
+      ++row;
+      // The deviator's rows: m_a = Q_q cos b - V sin b, m_b = Q_q sin b + V cos b.
+      const double ma = m.Qq * cb - m.V * sb, mb = m.Qq * sb + m.V * cb;
+      const double ma_p = m.Qq_p * cb - m.V_p * sb, mb_p = m.Qq_p * sb + m.V_p * cb;
+      const double ma_q = m.Qq_q * cb - m.V_q * sb, mb_q = m.Qq_q * sb + m.V_q * cb;
+      const double ma_b = (m.Qq_b - m.V) * cb - (m.Qq + m.V_b) * sb, mb_b = (m.Qq_b - m.V) * sb + (m.Qq + m.V_b) * cb;
+      const double ma_Y = m.Qq_Y * cb - m.V_Y * sb, mb_Y = m.Qq_Y * sb + m.V_Y * cb;
+      auto row_a = [&](int rr) {
+        put(rr, 0, 3.0 * l * (pt.dG_dp * ma + G * ma_p) * ds);
+        put(rr, ia, (1.0 + 3.0 * G * l * along_a(ma_q, ma_b)) * ds);
+        put(rr, ib, 3.0 * G * l * along_b(ma_q, ma_b) * ds);
+        put(rr, ik, 3.0 * G * l * ma_Y * Yk * ds);
+        put(rr, il, 3.0 * G * ma * ds);
+      };
+      if (ia >= 0) row_a(row++);
+      if (ib >= 0) {
+        put(row, 0, 3.0 * l * (pt.dG_dp * mb + G * mb_p) * ds);
+        put(row, ia, 3.0 * G * l * along_a(mb_q, mb_b) * ds);
+        put(row, ib, (1.0 + 3.0 * G * l * along_b(mb_q, mb_b)) * ds);
+        put(row, ik, 3.0 * G * l * mb_Y * Yk * ds);
+        put(row, il, 3.0 * G * mb * ds);
+        ++row;
+      }
+      // driver: kd_end(dl, Q_p, Q_d, dl_t) by the chain rule
+      put(row, 0, -(pt.d_Qp * m.Qp_p + pt.d_Qd * m.Qd_p) * ss);
+      put(row, ia, -(pt.d_Qp * along_a(m.Qp_q, m.Qp_b) + pt.d_Qd * along_a(m.Qd_q, m.Qd_b)) * ss);
+      put(row, ib, -(pt.d_Qp * along_b(m.Qp_q, m.Qp_b) + pt.d_Qd * along_b(m.Qd_q, m.Qd_b)) * ss);
+      put(row, ik, (1.0 - (pt.d_Qp * m.Qp_Y + pt.d_Qd * m.Qd_Y) * Yk) * ss);
+      put(row, il, -pt.d_dl * ss);
+      put(row, it, -pt.d_dlt * ss);
+      ++row;
+      // shear consistency (at the apex, the row on e1)
+      if (il >= 0) {
+        if (apex_) {
+          row_a(row++);
+        } else {
+          put(row, 0, pt.F_p * s);
+          put(row, ia, along_a(pt.F_q, pt.F_b) * s);
+          put(row, ib, along_b(pt.F_q, pt.F_b) * s);
+          put(row, ik, (pt.F_Y - (1.0 + pt.x)) * Yk * s);
+          put(row, il, -inverse_.derivative(l) * pt.Y * s);
+          ++row;
+        }
+      }
+      if (it >= 0) {
+        put(row, 0, -s);
+        put(row, ik, -pt.x_t * Yk * s);
+        put(row, it, -inverse_.derivative(pt.lt) * pt.Y * s);
+      }
+    }
+
+    const Model& model_;
+    OverstressInverse inverse_;
+    double k0_[kStates];
+    CoaxialPlane plane_;  // eqs. (2.5.3), (2.5.11)
+    struct Ray {
+      double cos, sin;
+    };
+    Ray corners_[2]{};  // the directions b of the triaxial corners, theta_tr -+ pi/6
+    double p_tr_ = 0.0, q_tr_ = 0.0;
+    double scale_ = 1.0, inv_scale_ = 1.0, state_scale_ = 1.0, inv_state_scale_ = 1.0, q_apex_ = 0.0;
+    double K_ = 0.0, G_ = 0.0;  // constant moduli (0: pressure-dependent)
+    bool has_q_ = false, has_b_ = false, apex_ = false, allow_apex_ = true, shear_ = false, tension_ = false;
+    double p_ = 0.0, qa_ = 0.0, qb_ = 0.0, kd_ = 0.0;
+    double end_Qp_ = 0.0, end_Qd_ = 0.0;  // the flow at the end of the last Newton solve, for finish()
+    LodeForm trial_form_;                 // the form at the trial, from trial_overstress()
+    bool has_trial_form_ = false;
+  };
+
   const Model& model_;
+  Path path_;
 };
 
 }  // namespace rktsph::detail

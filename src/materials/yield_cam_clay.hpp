@@ -15,6 +15,7 @@
 #include <numbers>
 
 #include "core/types.hpp"
+#include "materials/lode_form.hpp"
 #include "materials/pq_form.hpp"
 #include "materials/tensor.hpp"
 
@@ -26,6 +27,8 @@ struct CamClaySurface {
 
   /// With M(theta) the return moves in the coaxial deviatoric plane (method-notes §2.5).
   bool lode_depends() const { return lode_dependent; }
+  /// M(theta) is smooth in sin 3 theta: no stop at the triaxial corners (method-notes eq. (2.5.16)).
+  bool sharp_corners() const { return false; }
 
   /// Tension guard (method-notes §1.8): for p' <= kTensionGuard * p_c, F = p' (no q term).
   static constexpr double kTensionGuard = 1e-6;
@@ -116,6 +119,45 @@ struct CamClaySurface {
     f.Q_qq = 2.0 / Y;
     f.Q_pY = -2.0 * M2 * p / (Y * Y);
     f.Q_qY = -2.0 * q / (Y * Y);
+    return f;
+  }
+
+  /// F and the flow in (p', q, theta) with M(theta) (method-notes eq. (2.5.13)): Q_p and Q_q as
+  /// in pq() with M(theta), Q_theta = 2 M M' p'(p' - p_c)/p_c, and their derivatives. Below the
+  /// Lode guard M = M_c with no Lode term, as slope() gives.
+  LodeForm pq_theta(double p, double q, const LodeAngle& lode, double Y) const {
+    double M = M_c, dM = 0.0, d2M = 0.0;  // M and its derivatives along theta
+    if (lode_dependent && q > kLodeGuard * Y) {
+      // M(x) = 6 s/(3 - s x), x = sin(3 theta): dM/dx = 6 s^2/den^2, d2M/dx2 = 12 s^3/den^3.
+      const double sphi = 3.0 * M_c / (6.0 + M_c);
+      const double den = 3.0 - sphi * lode.sin3;
+      M = 6.0 * sphi / den;
+      const double M_x = M * sphi / den, M_xx = 2.0 * M_x * sphi / den;
+      dM = 3.0 * lode.cos3 * M_x;
+      d2M = 9.0 * (lode.cos3 * lode.cos3 * M_xx - lode.sin3 * M_x);
+    }
+    LodeForm f;
+    const double M2 = M * M;
+    if (p <= kTensionGuard * Y) {
+      f.F = p;
+      f.F_p = 1.0;
+    } else {
+      f.F = p + q * q / (M2 * p);
+      f.F_p = 1.0 - q * q / (M2 * p * p);
+      f.F_q = 2.0 * q / (M2 * p);
+      f.F_theta = -2.0 * q * q * dM / (M2 * M * p);
+    }
+    const double ell = p * (p - Y);  // f = q^2 + M^2 p'(p' - p_c)
+    f.Q_p = M2 * (2.0 * p - Y) / Y;
+    f.Q_q = 2.0 * q / Y;
+    f.Q_theta = 2.0 * M * dM * ell / Y;
+    f.Q_pp = 2.0 * M2 / Y;
+    f.Q_ptheta = 2.0 * M * dM * (2.0 * p - Y) / Y;
+    f.Q_qq = 2.0 / Y;
+    f.Q_thetatheta = 2.0 * (dM * dM + M * d2M) * ell / Y;
+    f.Q_pY = -2.0 * M2 * p / (Y * Y);
+    f.Q_qY = -2.0 * q / (Y * Y);
+    f.Q_thetaY = -2.0 * M * dM * p * p / (Y * Y);
     return f;
   }
 

@@ -15,6 +15,7 @@
 #include <numbers>
 
 #include "core/types.hpp"
+#include "materials/lode_form.hpp"
 #include "materials/tensor.hpp"
 
 namespace rktsph {
@@ -33,12 +34,14 @@ struct LodeFactor {
   double transition = kDefaultTransition;  // theta_T, radians
   double A_plus = 0.0, B_plus = 0.0;       // rounding for theta > theta_T
   double A_minus = 0.0, B_minus = 0.0;     // rounding for theta < −theta_T
+  double cos_transition = std::cos(kDefaultTransition);  // cos(theta_T), for along()
 
   /// A and B from continuity of K and dK/dtheta at ±theta_T (eq. 1.11.3).
   static LodeFactor of(double sin_angle, double transition = kDefaultTransition) {
     LodeFactor f;
     f.sin_angle = sin_angle;
     f.transition = transition;
+    f.cos_transition = std::cos(transition);
     const double t = transition, r3 = std::sqrt(3.0);
     for (double sign : {1.0, -1.0}) {
       const double B = (sign * std::sin(t) + sin_angle * std::cos(t) / r3) / (3.0 * std::cos(3.0 * t));
@@ -64,6 +67,21 @@ struct LodeFactor {
     const double dKdtheta = -std::sin(theta) - sin_angle * std::cos(theta) / r3;
     return {K, dKdtheta / (3.0 * std::cos(3.0 * theta))};  // cos(3 theta) >= cos(3 theta_T) > 0 here
   }
+
+  struct AlongTheta {
+    double K, dK, d2K;  // K and its first two derivatives along theta
+  };
+  /// K(theta) of eq. (1.11.2) and dK/dtheta, d2K/dtheta2 (method-notes eq. (2.5.12)), for the
+  /// (p', q, theta) return: from the angle's sines and cosines, without asin.
+  AlongTheta along(const LodeAngle& lode) const {
+    if (lode.cos1 < cos_transition) {  // |theta| > theta_T
+      const double A = lode.sin1 > 0.0 ? A_plus : A_minus, B = lode.sin1 > 0.0 ? B_plus : B_minus;
+      return {A - B * lode.sin3, -3.0 * B * lode.cos3, 9.0 * B * lode.sin3};
+    }
+    const double r3 = std::sqrt(3.0);
+    const double K = lode.cos1 - sin_angle * lode.sin1 / r3;
+    return {K, -lode.sin1 - sin_angle * lode.cos1 / r3, -K};
+  }
 };
 
 struct MohrCoulombSurface {
@@ -77,6 +95,9 @@ struct MohrCoulombSurface {
 
   /// K(theta): the return moves in the coaxial deviatoric plane (method-notes §2.5).
   bool lode_depends() const { return true; }
+  /// The flow turns by 60 deg within the rounding, 2 (30 deg - theta_T) wide, at the triaxial
+  /// corners: the (p', q, theta) return stops a Newton step there (method-notes eq. (2.5.16)).
+  bool sharp_corners() const { return true; }
 
   /// theta_T in radians, in [kMinTransitionDegrees, kMaxTransitionDegrees] degrees.
   static MohrCoulombSurface make(double phi, double psi, double eps,
@@ -93,6 +114,46 @@ struct MohrCoulombSurface {
   Sym6 flow(const Sym6& sigma, double Y) const { return derivative(sigma, Y, lode_Q, round_Q * Y); }
   /// Q of eq. (1.11.4), for the tests.
   double potential(const Sym6& sigma, double Y) const { return function(sigma, Y, lode_Q, round_Q * Y); }
+
+  /// F and Q of eqs. (1.11.1), (1.11.4) in (p', q, theta) with the derivatives of the exact
+  /// Jacobian (method-notes eq. (2.5.12)). Below the guard theta is taken as 0 with no Lode
+  /// term, as value() and flow() do; without rounding, Q_q = K on the axis (its limit along the
+  /// deviator, for the apex of §2.5).
+  LodeForm pq_theta(double p, double q, const LodeAngle& lode, double Y) const {
+    const bool lode_defined = q > kLodeGuard * Y;
+    const LodeFactor::AlongTheta kF = lode_defined ? lode_F.along(lode) : LodeFactor::AlongTheta{1.0, 0.0, 0.0};
+    const LodeFactor::AlongTheta kQ = lode_defined ? lode_Q.along(lode) : LodeFactor::AlongTheta{1.0, 0.0, 0.0};
+    const double r3 = std::sqrt(3.0);
+    LodeForm f;
+    const double dF = round_F * Y, dQ = round_Q * Y;
+    const double RF = std::sqrt(q * q * kF.K * kF.K + dF * dF);
+    f.F = RF - r3 * lode_F.sin_angle * p;
+    f.F_p = -r3 * lode_F.sin_angle;
+    if (RF > 0.0) {
+      f.F_q = q * kF.K * kF.K / RF;
+      f.F_theta = q * q * kF.K * kF.dK / RF;
+      f.F_Y = round_F * dF / RF;
+    } else {
+      f.F_q = kF.K;
+    }
+    const double RQ = std::sqrt(q * q * kQ.K * kQ.K + dQ * dQ);
+    f.Q_p = -r3 * lode_Q.sin_angle;
+    if (!(RQ > 0.0)) {
+      f.Q_q = kQ.K;
+      return f;
+    }
+    // Q_q = q K^2/R, Q_theta = q^2 K K'/R with R = sqrt(q^2 K^2 + delta^2), and R^2 - q^2 K^2 = delta^2.
+    const double K2 = kQ.K * kQ.K, KdK = kQ.K * kQ.dK;
+    const double RQ3 = RQ * RQ * RQ;
+    f.Q_q = q * K2 / RQ;
+    f.Q_theta = q * q * KdK / RQ;
+    f.Q_qq = K2 * dQ * dQ / RQ3;
+    f.Q_qtheta = q * KdK * (q * q * K2 + 2.0 * dQ * dQ) / RQ3;
+    f.Q_thetatheta = q * q * (kQ.K * kQ.d2K * RQ * RQ + kQ.dK * kQ.dK * dQ * dQ) / RQ3;
+    f.Q_qY = -q * K2 * round_Q * dQ / RQ3;
+    f.Q_thetaY = -q * q * KdK * round_Q * dQ / RQ3;
+    return f;
+  }
 
   /// x = sin(3 theta) of eq. (1.1.3), 0 below the guard.
   static double lode_x(const Sym6& s, double J2, double Y) {

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <numbers>
 #include <string>
@@ -15,10 +16,15 @@
 #include "case/case_builder.hpp"
 #include "core/error.hpp"
 #include "material_test_util.hpp"
-#include "materials/perzyna_models.hpp"
-#include "schemes/simulation.hpp"
+#include "materials/hardening.hpp"
+#include "materials/lode_form.hpp"
 #include "materials/material_point_path.hpp"
+#include "materials/perzyna.hpp"
+#include "materials/perzyna_models.hpp"
 #include "materials/tensor.hpp"
+#include "materials/yield_cam_clay.hpp"
+#include "materials/yield_mohr_coulomb.hpp"
+#include "schemes/simulation.hpp"
 
 namespace rktsph {
 namespace {
@@ -320,6 +326,303 @@ TEST(ImplicitSource, EverySchemeReportsItsSourceCounts) {
     EXPECT_GT(s.elastic_points + s.rk4_points + s.implicit_points, 40 * 100) << scheme;
     EXPECT_GE(solver.source_seconds(), 0.0);
   }
+}
+
+// ---- the (p', q, theta) return of the Lode-dependent surfaces (method-notes eqs. (2.5.11)–(2.5.15))
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+
+// A stress of mean -p, size q and Lode angle theta (eq. (1.1.3), tension positive: +30 deg is
+// triaxial compression), its principal axes turned away from x, y, z by `turn` radians.
+Sym6 stress_of(double p, double q, double theta, double turn = 0.4) {
+  const double s1 = 2.0 * q / 3.0 * std::sin(theta + 2.0 * std::numbers::pi / 3.0);
+  const double s2 = 2.0 * q / 3.0 * std::sin(theta);
+  const double s3 = 2.0 * q / 3.0 * std::sin(theta - 2.0 * std::numbers::pi / 3.0);
+  // R = Rz(turn) Rx(0.7 turn) applied to diag(s1, s2, s3): R diag R^T.
+  const double c = std::cos(turn), s = std::sin(turn), cx = std::cos(0.7 * turn), sx = std::sin(0.7 * turn);
+  const double R[3][3] = {{c, -s * cx, s * sx}, {s, c * cx, -c * sx}, {0.0, sx, cx}};
+  const double d[3] = {s1, s2, s3};
+  double m[3][3];
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      m[i][j] = 0.0;
+      for (int k = 0; k < 3; ++k) m[i][j] += R[i][k] * d[k] * R[j][k];
+    }
+  }
+  return {m[0][0] - p, m[1][1] - p, m[2][2] - p, m[0][1], m[1][2], m[0][2]};
+}
+
+double lode_sin3(const Sym6& sigma) {
+  const Sym6 s = tensor::deviator(sigma);
+  return MohrCoulombSurface::lode_x(s, 0.5 * tensor::ddot(s, s), 1.0);
+}
+
+TEST(ImplicitSource, CoaxialPlaneTurnsTheLodeAngleAsTheSurfacesMeasureIt) {
+  // Along e2 the Lode angle falls: theta = theta_tr - b (eq. (2.5.11)), folded past the corners.
+  for (double theta : {-30.0, -29.999, -29.8, -20.0, -3.0, 0.0, 11.0, 29.5, 29.99, 30.0}) {
+    const Sym6 trial = stress_of(1e4, 3e4, theta * kDeg);
+    const CoaxialPlane plane = CoaxialPlane::of(tensor::deviator(trial), 1e-9);
+    ASSERT_TRUE(plane.has_e1);
+    EXPECT_NEAR(plane.theta(), theta * kDeg, 1e-12) << theta;
+    EXPECT_EQ(plane.has_e2, std::abs(theta) < 29.9999) << theta;
+    if (!plane.has_e2) continue;
+    // e2 is the part of dev(s^2) normal to s, of size cos(3 theta): its round-off grows near the corners.
+    const double tolerance = 1e-12 + 1e-15 / std::cos(3.0 * plane.theta());
+    for (double b : {-1.5, -1.0, -0.6, -0.1, -1e-4, 0.0, 2e-3, 0.3, 0.8, 1.04, 1.5}) {
+      const Sym6 s = plane.deviator(2.5e4, b);
+      const FoldedLodeAngle a = plane.lode_angle(std::cos(b), std::sin(b));
+      const double folded = std::atan2(a.lode.sin1, a.lode.cos1);
+      EXPECT_NEAR(invariants(s).q, 2.5e4, 1e-10 * 2.5e4);
+      EXPECT_NEAR(a.lode.sin3, lode_sin3(s), tolerance) << theta << " " << b;
+      EXPECT_NEAR(a.lode.sin3, std::sin(3.0 * (plane.theta() - b)), 1e-12) << theta << " " << b;
+      EXPECT_LE(std::abs(folded), std::numbers::pi / 6.0 + 1e-12) << theta << " " << b;
+      EXPECT_NEAR(a.lode.sin3, std::sin(3.0 * folded), 1e-12) << theta << " " << b;
+      EXPECT_NEAR(a.lode.cos3, std::cos(3.0 * folded), 1e-12) << theta << " " << b;
+      // dtheta/db = -sign, by differences (away from the corners, where the fold turns).
+      const double h = 1e-7;
+      const FoldedLodeAngle up = plane.lode_angle(std::cos(b + h), std::sin(b + h));
+      const FoldedLodeAngle down = plane.lode_angle(std::cos(b - h), std::sin(b - h));
+      if (std::abs(std::abs(folded) - std::numbers::pi / 6.0) > 1e-5) {
+        const double slope =
+            (std::atan2(up.lode.sin1, up.lode.cos1) - std::atan2(down.lode.sin1, down.lode.cos1)) / (2 * h);
+        EXPECT_NEAR(slope, -a.sign, 1e-6) << theta << " " << b;
+      }
+    }
+  }
+}
+
+// The form against the surface's own value() and flow() at (p', q, theta), and its second
+// derivatives against central differences of the first.
+template <class Surface>
+void check_lode_form(const Surface& surface, double p, double q, double theta, double Y, const std::string& what) {
+  const Sym6 sigma = stress_of(p, q, theta);
+  const LodeForm f = surface.pq_theta(p, q, LodeAngle::of(theta), Y);
+  const double scale = std::max({std::abs(f.F), Y, q});
+  EXPECT_NEAR(f.F, surface.value(sigma, Y), 1e-12 * scale) << what;
+  // m = -(Q_p/3) 1 + sqrt(3/2) (Q_q e1 - (Q_theta/q) e2) in the plane of sigma (eq. (2.5.13)).
+  const CoaxialPlane plane = CoaxialPlane::of(tensor::deviator(sigma), 1e-9 * Y);
+  const Sym6 m = surface.flow(sigma, Y);
+  const double size = std::max({std::abs(f.Q_p), std::abs(f.Q_q), std::abs(f.Q_theta / q), 1.0});
+  EXPECT_NEAR(-tensor::trace(m), f.Q_p, 1e-11 * size) << what;
+  EXPECT_NEAR(tensor::ddot(m, plane.e1), std::sqrt(1.5) * f.Q_q, 1e-11 * size) << what;
+  if (plane.has_e2) {
+    EXPECT_NEAR(tensor::ddot(m, plane.e2), -std::sqrt(1.5) * f.Q_theta / q, 1e-9 * size) << what;
+  }
+  // Second derivatives.
+  const double hp = 1e-6 * std::max(std::abs(p), Y), hq = 1e-6 * q, ht = 1e-6, hY = 1e-6 * Y;
+  auto at = [&](double dp, double dq, double dt, double dY) {
+    return surface.pq_theta(p + dp, q + dq, LodeAngle::of(theta + dt), Y + dY);
+  };
+  const LodeForm pp = at(hp, 0, 0, 0), pm = at(-hp, 0, 0, 0), qp = at(0, hq, 0, 0), qm = at(0, -hq, 0, 0);
+  const LodeForm tp = at(0, 0, ht, 0), tm = at(0, 0, -ht, 0), Yp = at(0, 0, 0, hY), Ym = at(0, 0, 0, -hY);
+  auto expect = [&](double analytic, double difference, double unit, const char* name) {
+    EXPECT_NEAR(analytic, difference, 1e-6 * std::max(std::abs(analytic), unit)) << what << " " << name;
+  };
+  expect(f.F_p, (pp.F - pm.F) / (2 * hp), 1.0, "F_p");
+  expect(f.F_q, (qp.F - qm.F) / (2 * hq), 1.0, "F_q");
+  expect(f.F_theta, (tp.F - tm.F) / (2 * ht), q, "F_theta");
+  expect(f.F_Y, (Yp.F - Ym.F) / (2 * hY), 1.0, "F_Y");
+  expect(f.Q_pp, (pp.Q_p - pm.Q_p) / (2 * hp), 1.0 / Y, "Q_pp");
+  expect(f.Q_pq, (qp.Q_p - qm.Q_p) / (2 * hq), 1.0 / Y, "Q_pq");
+  expect(f.Q_ptheta, (tp.Q_p - tm.Q_p) / (2 * ht), 1.0, "Q_ptheta");
+  expect(f.Q_ptheta, (pp.Q_theta - pm.Q_theta) / (2 * hp), 1.0, "Q_thetap");
+  expect(f.Q_qq, (qp.Q_q - qm.Q_q) / (2 * hq), 1.0 / Y, "Q_qq");
+  expect(f.Q_qtheta, (tp.Q_q - tm.Q_q) / (2 * ht), 1.0, "Q_qtheta");
+  expect(f.Q_qtheta, (qp.Q_theta - qm.Q_theta) / (2 * hq), 1.0, "Q_thetaq");
+  expect(f.Q_thetatheta, (tp.Q_theta - tm.Q_theta) / (2 * ht), q, "Q_thetatheta");
+  expect(f.Q_pY, (Yp.Q_p - Ym.Q_p) / (2 * hY), 1.0 / Y, "Q_pY");
+  expect(f.Q_qY, (Yp.Q_q - Ym.Q_q) / (2 * hY), 1.0 / Y, "Q_qY");
+  expect(f.Q_thetaY, (Yp.Q_theta - Ym.Q_theta) / (2 * hY), 1.0, "Q_thetaY");
+}
+
+TEST(ImplicitSource, LodeFormsAreTheSurfacesInInvariants) {
+  const std::vector<double> thetas{-29.95, -29.0, -12.0, 0.0, 7.0, 28.0, 29.8, 29.97};
+  for (double eps : {0.0, 0.1}) {
+    for (double psi : {0.0, 10.0, 30.0}) {
+      const MohrCoulombSurface mc = MohrCoulombSurface::make(30.0 * kDeg, psi * kDeg, eps);
+      for (double theta : thetas) {
+        for (double q : {0.05, 1.0, 20.0}) {
+          check_lode_form(mc, 2.0, q, theta * kDeg, 1.0,
+                          fmt::format("MC eps {} psi {} theta {} q {}", eps, psi, theta, q));
+        }
+      }
+    }
+  }
+  CamClaySurface cc;
+  cc.M_c = 1.2;
+  cc.lode_dependent = true;
+  for (double theta : thetas) {
+    for (double p : {0.3, 0.7, 1.4}) {
+      check_lode_form(cc, p * 1e5, 0.6e5, theta * kDeg, 1e5, fmt::format("CC theta {} p {}", theta, p));
+    }
+  }
+}
+
+using MohrCoulombModel = PerzynaMaterial<MohrCoulombSurface, LinearHardening>;
+using CamClayModel = PerzynaMaterial<CamClaySurface, CamClayHardening>;
+
+template <class Model>
+Return return_by(const Model& m, const Sym6& trial, double tau, const std::vector<double>& k0,
+                 typename detail::PerzynaBackwardEuler<Model>::Path path) {
+  const detail::PerzynaBackwardEuler<Model> solver(m, path);
+  Return r;
+  r.k.assign(k0.size(), 0.0);
+  r.outcome = solver.solve(trial, k0.data(), tau, r.sigma, r.k.data());
+  return r;
+}
+
+struct Agreement {
+  int compared = 0, generic_failed = 0, exact_failed = 0, both_failed = 0, at_apex = 0;
+  int exact_failed_moderate = 0;         // on trials within 30 times the strength
+  double worst = 0.0, worst_apex = 0.0;  // largest stress or history difference, relative
+  long exact_iterations = 0, generic_iterations = 0;
+  int most_iterations = 0;
+};
+
+// The (p', q, theta) return against the generic (mean, a, b) one from one trial. Where the
+// exact-Jacobian problem alone fails, the fall-back must give the generic return.
+template <class Model>
+void compare_returns(const Model& m, const Sym6& trial, const std::vector<double>& k0, double tau, Agreement& a,
+                     const std::string& what, bool moderate = false) {
+  using Path = typename detail::PerzynaBackwardEuler<Model>::Path;
+  const Return slow = return_by(m, trial, tau, k0, Path::generic);
+  if (!slow.outcome.converged) {
+    ++a.generic_failed;
+    if (!return_by(m, trial, tau, k0, Path::fastest).outcome.converged) {
+      ++a.both_failed;
+      if (std::getenv("RKTSPH_PRINT_FAILED") != nullptr) std::printf("both failed: %s\n", what.c_str());
+    }
+    return;
+  }
+  Return fast = return_by(m, trial, tau, k0, Path::exact_only);
+  if (!fast.outcome.converged) {
+    ++a.exact_failed;
+    if (moderate) ++a.exact_failed_moderate;
+    if (std::getenv("RKTSPH_PRINT_FAILED") != nullptr) std::printf("exact failed: %s\n", what.c_str());
+    fast = return_by(m, trial, tau, k0, Path::fastest);
+    ASSERT_TRUE(fast.outcome.converged) << what;
+  } else {
+    ++a.compared;
+    a.exact_iterations += fast.outcome.iterations;
+    a.generic_iterations += slow.outcome.iterations;
+    a.most_iterations = std::max(a.most_iterations, fast.outcome.iterations);
+  }
+  const double scale = std::max({m.hardening().size(k0.data()), q_of(trial), std::abs(invariants(trial).p)});
+  double worst = 0.0;
+  for (std::size_t i = 0; i < 6; ++i) worst = std::max(worst, std::abs(fast.sigma[i] - slow.sigma[i]) / scale);
+  for (std::size_t j = 0; j < k0.size(); ++j) {
+    worst = std::max(worst, std::abs(fast.k[j] - slow.k[j]) / std::max(std::abs(slow.k[j]), 1e-6));
+  }
+  // At the apex the generic problem takes the flow at a deviator of 1e-6 of the scale on the
+  // mean stress, so its volumetric part carries 1e-10 of round-off, times the multiplier: those
+  // returns are checked to 1e-6 (and the exact ones' mean stress below).
+  const bool apex = q_of(fast.sigma) == 0.0 && q_of(trial) > 0.0;
+  if (apex) {
+    ++a.at_apex;
+    a.worst_apex = std::max(a.worst_apex, worst);
+  } else {
+    a.worst = std::max(a.worst, worst);
+  }
+  EXPECT_LT(worst, apex ? 1e-6 : 1e-9) << what
+                                       << fmt::format(" (iterations {} / {})", fast.outcome.iterations,
+                                                      slow.outcome.iterations);
+}
+
+void print_agreement(const char* model, const Agreement& a) {
+  std::printf(
+      "[ figures  ] %s: %d returns agree with the generic one to %.1e (%d at the apex, to %.1e), "
+      "Newton iterations %.2f on average (generic %.2f), %d at most; the generic one failed on %d (the new "
+      "one on %d of them), the exact one alone on %d (the fall-back's)\n",
+      model, a.compared, a.worst, a.at_apex, a.worst_apex, static_cast<double>(a.exact_iterations) / a.compared,
+      static_cast<double>(a.generic_iterations) / a.compared, a.most_iterations, a.generic_failed, a.both_failed,
+      a.exact_failed);
+}
+
+TEST(ImplicitSource, LodeReturnIsTheGenericReturnOfMohrCoulomb) {
+  // Fluidities, cohesions 1 Pa - 100 kPa, psi = 0 and phi, tension cut-off off and on, trials
+  // about the triaxial corners, inside the rounding and at the apex, up to 10^4 times the strength.
+  const std::vector<double> thetas{-30.0, -29.99, -29.8, -29.0, -15.0, 0.0, 10.0, 29.5, 29.8, 29.99, 30.0};
+  Agreement a;
+  for (double gamma : {1.0, 1e2, 1e4, 1e6, kInf}) {
+    for (double c : {1.0, 1e2, 1e4, 1e5}) {
+      for (double psi : {0.0, 30.0}) {
+        for (bool cutoff : {false, true}) {
+          MohrCoulombParameters par;
+          par.elastic = ElasticConstants::from_E_nu(kE, kNu, 2000.0);
+          par.cohesion = c;
+          par.friction_angle = 30.0 * kDeg;
+          par.dilatancy = psi * kDeg;
+          par.fluidity = gamma;
+          par.hardening_modulus = -0.1 * c;
+          par.residual_cohesion = 0.5 * c;
+          if (cutoff) par.tension_cutoff = {true, 0.5 * c};
+          const auto material = make_perzyna_mohr_coulomb(par);
+          const auto& m = dynamic_cast<const MohrCoulombModel&>(*material);
+          const double cot = std::sqrt(3.0);  // cot 30 deg
+          for (double theta : thetas) {
+            for (double p : {2e4 + c, 5.0 * c, -0.5 * c * cot, -3.0 * c * cot}) {
+              for (double q_over : {1.2, 4.0, 30.0, 1e3}) {
+                const double q = q_over * (std::abs(p) + c);
+                const Sym6 trial = stress_of(p, q, theta * kDeg);
+                const std::string what = fmt::format("gamma {} c {} psi {} cutoff {} theta {} p {} q {}", gamma, c, psi,
+                                                     cutoff, theta, p, q);
+                compare_returns(m, trial, {0.002}, 1e-3, a, what, q_over < 100.0);
+              }
+            }
+            // Near the apex: a small deviator on a hydrostatic tension.
+            compare_returns(m, stress_of(-2.0 * c * cot, 0.01 * c, theta * kDeg), {0.0}, 1e-3, a,
+                            fmt::format("apex gamma {} c {} psi {} cutoff {} theta {}", gamma, c, psi, cutoff, theta));
+          }
+          compare_returns(m, stress_of(-2.0 * c * cot, 0.0, 0.0), {0.0}, 1e-3, a, "hydrostatic tension");
+        }
+      }
+    }
+  }
+  print_agreement("Mohr-Coulomb", a);
+  // Newton on (q_a, q_b) alone fails only from trials 10^3 times the strength or in tension
+  // beyond the apex, where the fall-back takes the generic path.
+  EXPECT_EQ(a.exact_failed_moderate, 0);
+  EXPECT_LE(a.exact_failed, a.compared / 50);
+  EXPECT_LE(a.both_failed, a.generic_failed / 2);
+}
+
+TEST(ImplicitSource, LodeReturnIsTheGenericReturnOfCamClayWithLodeDependentM) {
+  const std::vector<double> thetas{-30.0, -29.9, -20.0, 0.0, 17.0, 29.9, 30.0};
+  Agreement a;
+  for (bool pressure_dependent : {false, true}) {
+    for (double gamma : {1.0, 1e2, 1e4, 1e6, kInf}) {
+      for (double pc : {2e3, 2e5}) {
+        CamClayParameters par;
+        par.elastic = ElasticConstants::from_E_nu(kE, kNu, 2000.0);
+        par.M = 1.2;
+        par.lode_dependent_M = true;
+        par.lambda = 0.2;
+        par.kappa = 0.02;
+        par.e0 = 1.0;
+        par.p_c0 = pc;
+        par.fluidity = gamma;
+        if (pressure_dependent) {
+          par.elasticity = CamClayElasticity::pressure_dependent;
+          par.elastic_p_min = 1e-3 * pc;
+          par.elastic_p_max = 10.0 * pc;
+        }
+        const auto material = make_perzyna_cam_clay(par);
+        const auto& m = dynamic_cast<const CamClayModel&>(*material);
+        for (double theta : thetas) {
+          for (double p_over : {0.1, 0.4, 0.9, 1.6}) {
+            for (double q_over : {0.5, 1.5, 10.0}) {
+              const Sym6 trial = stress_of(p_over * pc, q_over * pc, theta * kDeg);
+              const std::string what = fmt::format("pressure {} gamma {} pc {} theta {} p/pc {} q/pc {}",
+                                                   pressure_dependent, gamma, pc, theta, p_over, q_over);
+              compare_returns(m, trial, {0.001, -0.002, pc}, 1e-3, a, what, true);
+            }
+          }
+        }
+      }
+    }
+  }
+  print_agreement("Cam-Clay with M(theta)", a);
+  EXPECT_EQ(a.exact_failed, 0);
 }
 
 }  // namespace
