@@ -69,8 +69,12 @@ def main():
         ax.plot([xc, ex[0]], [yc, ex[1]], "r:", lw=0.8)
         ax.plot([xc, en[0]], [yc, en[1]], "r:", lw=0.8)
     s = j["soil"]
-    ax.set_title(f"Bishop simplified: c = {s['cohesion_Pa'] / 1e3:.4g} kPa, φ = {s['friction_angle_deg']:.4g}°, "
-                 f"γ = {s['unit_weight_N_per_m3'] / 1e3:.4g} kN/m³; contours: least F per centre", fontsize=10)
+    if j.get("layered"):
+        ax.set_title(f"Bishop simplified, {len(j['bodies'])} bodies of their own soils; contours: least F per centre",
+                     fontsize=10)
+    else:
+        ax.set_title(f"Bishop simplified: c = {s['cohesion_Pa'] / 1e3:.4g} kPa, φ = {s['friction_angle_deg']:.4g}°, "
+                     f"γ = {s['unit_weight_N_per_m3'] / 1e3:.4g} kN/m³; contours: least F per centre", fontsize=10)
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
     ax.set_aspect("equal")

@@ -35,6 +35,17 @@ add_test(NAME fos_quick
                  -- --set geometry.spacing=0.5 --tol 0.02 --jobs 2 --threads 2 --quiet)
 set_tests_properties(fos_quick PROPERTIES LABELS validation PROCESSORS 2 TIMEOUT 600)
 
+# The 2:1 slope with a weak layer (cases/examples/slope_2to1_weak_layer.toml; docs/fos.md,
+# "Measured") at H/8, the layer one spacing thick: F against Bishop's 1.2343 (rktsph lem, 50
+# slices; the independent scripts/bishop_layered.py 1.2394) within issue 50's 3 %. Measured
+# 1.2305 [1.2266, 1.2344] (-0.3 %), the same bracket as at H/16; 15 s on two shared cores.
+add_test(NAME fos_slope_weak_layer_h8
+         COMMAND /usr/bin/python3 ${PROJECT_SOURCE_DIR}/scripts/check_fos.py --binary $<TARGET_FILE:rktsph>
+                 --case ${PROJECT_SOURCE_DIR}/cases/examples/slope_2to1_weak_layer.toml
+                 --out ${CMAKE_BINARY_DIR}/test-out/fos_slope_weak_layer_h8 --scale 0.810176 --low 0.97 --high 1.03
+                 -- --set geometry.spacing=1.25 --jobs 2 --threads 2 --quiet)
+set_tests_properties(fos_slope_weak_layer_h8 PROPERTIES LABELS validation PROCESSORS 2 TIMEOUT 600)
+
 # The same search in the large-deformation solver (`--solver v2`) on Case 12's soil under a
 # flexible 200 kPa (cases/examples/strip_footing_fos_2d.toml) at B/10, tolerance 2 %: F against
 # Prandtl's (2 + pi) c / 200 kPa = 1.2854 must lie within issue 13's -3/+8 % (measured 1.2793,

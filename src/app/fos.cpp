@@ -1,5 +1,6 @@
 // `rktsph fos CASE`: trials of the case at reduced strength (or at a multiplied load), run in
-// parallel when threads allow, classified by the rule of docs/cases.md §1.3, searched by
+// process (app/fos_trial.hpp) and side by side when threads allow, classified by the hold rule
+// (app/fos_criterion.hpp; the load factor by docs/cases.md §1.3), searched by
 // app/fos_search.cpp.
 #include "app/fos.hpp"
 
@@ -7,11 +8,9 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <limits>
 #include <map>
-#include <sstream>
 #include <thread>
 
 #include <fmt/format.h>
@@ -20,7 +19,8 @@
 
 #include "app/fos_search.hpp"
 #include "app/fos_setup.hpp"
-#include "app/run_case.hpp"
+#include "app/fos_trial.hpp"
+#include "app/signals.hpp"
 #include "core/error.hpp"
 #include "io/output_files.hpp"
 #include "validation/cut_common.hpp"
@@ -36,52 +36,22 @@ namespace {
 struct Trial {
   int index = 0;  // 1-based, in the order the trials were started
   double factor = 0.0;
-  fs::path folder;
-  std::vector<std::string> overrides;
+  fs::path history_file;  // trial_NN.csv
+  fs::path frame_file;    // trial_NN.vtu
+  fos::TrialResult result;
+  std::string error;  // the trial could not run at all (its input refused)
   int exit_code = -1;
-  std::string error;
-  double seconds = 0.0;
-  std::vector<double> t, u, ke;  // the histories: time, monitored displacement, kinetic energy
+  // The load factor's classification (CASES.md §1.3) on the histories.
+  std::vector<double> ke_at_t;  // the kinetic energy at the monitor's sample times
   validation::Classification classification;
-  std::string outcome;  // stable, collapse, undecided, or unstable (the solver stopped)
+  std::string outcome;  // stable, collapse, undecided (load factor), or unstable (the solver stopped)
   bool stable = false;
   bool used = false;  // on the sequential search's path (else speculative)
 };
 
-// The columns `names` of a CSV file with a header row.
-std::vector<std::vector<double>> read_columns(const fs::path& file, const std::vector<std::string>& names) {
-  std::ifstream in(file);
-  if (!in) throw IoError(fmt::format("{}: cannot read the trial's table", file.string()));
-  std::string line;
-  std::getline(in, line);
-  std::vector<std::string> header;
-  {
-    std::stringstream s(line);
-    std::string cell;
-    while (std::getline(s, cell, ',')) header.push_back(cell);
-  }
-  std::vector<std::size_t> cols;
-  for (const std::string& n : names) {
-    const auto it = std::find(header.begin(), header.end(), n);
-    if (it == header.end()) throw IoError(fmt::format("{}: no column '{}'", file.string(), n));
-    cols.push_back(static_cast<std::size_t>(it - header.begin()));
-  }
-  std::vector<std::vector<double>> out(names.size());
-  std::vector<double> row;
-  while (std::getline(in, line)) {
-    if (line.empty()) continue;
-    row.clear();
-    std::stringstream s(line);
-    std::string cell;
-    while (std::getline(s, cell, ',')) row.push_back(std::strtod(cell.c_str(), nullptr));
-    if (row.size() < header.size()) break;  // a row cut short by a stopped run
-    for (std::size_t k = 0; k < cols.size(); ++k) out[k].push_back(row[cols[k]]);
-  }
-  return out;
-}
-
 // Linear interpolation of f(t) at tq (clamped); t increasing.
 double interpolate(const std::vector<double>& t, const std::vector<double>& f, double tq) {
+  if (t.empty()) return 0.0;
   if (tq <= t.front()) return f.front();
   if (tq >= t.back()) return f.back();
   const auto k = static_cast<std::size_t>(std::upper_bound(t.begin(), t.end(), tq) - t.begin());
@@ -89,36 +59,39 @@ double interpolate(const std::vector<double>& t, const std::vector<double>& f, d
   return (1.0 - w) * f[k - 1] + w * f[k];
 }
 
-// The trial's histories from its probes.csv and energy.csv, and its classification.
-void classify(Trial& tr, const fos::Monitor& m) {
-  const std::string prefix = std::string(fos::kMonitorProbe) + ".";
-  std::vector<std::string> names = {"t"};
-  for (std::size_t d = 0; d < m.direction.size(); ++d) names.push_back(prefix + "u" + std::string(kAxisNames[d]));
-  const auto probes = read_columns(tr.folder / "probes.csv", names);
-  const auto energy = read_columns(tr.folder / "energy.csv", {"t", m.kinetic_column});
-  tr.t = probes[0];
-  tr.u.assign(tr.t.size(), 0.0);
-  for (std::size_t d = 0; d < m.direction.size(); ++d) {
-    for (std::size_t k = 0; k < tr.t.size(); ++k) tr.u[k] += m.direction[d] * probes[d + 1][k];
-  }
-  tr.ke.clear();
-  for (double t : tr.t) tr.ke.push_back(energy[0].empty() ? 0.0 : interpolate(energy[0], energy[1], t));
-  if (!tr.t.empty()) tr.classification = validation::classify_cut(tr.t, tr.u, tr.ke, m.length, m.window);
+// The trial's outcome: by the hold rule (strength reduction, decided while it ran), or by the
+// window rule of CASES.md §1.3 on its histories (the load factor).
+void classify(Trial& tr, const fos::Monitor& m, bool by_hold) {
+  const fos::TrialHistory& h = tr.result.history;
+  tr.ke_at_t.clear();
+  const std::vector<double>& kinetic =
+      m.kinetic_column == "kinetic_stress_points" ? h.kinetic_stress_points : h.kinetic;
+  for (double t : h.t) tr.ke_at_t.push_back(interpolate(h.energy_t, kinetic, t));
+  if (!by_hold && !h.t.empty()) tr.classification = validation::classify_cut(h.t, h.uc, tr.ke_at_t, m.length, m.window);
   if (tr.exit_code == kExitUnstable) {
     tr.outcome = "unstable";
     tr.stable = false;
+  } else if (by_hold) {
+    tr.outcome = fos::hold_outcome_name(tr.result.hold_outcome);
+    tr.stable = tr.result.hold_outcome == fos::HoldOutcome::stable;
   } else {
     tr.outcome = validation::outcome_name(tr.classification.outcome);
     tr.stable = tr.classification.outcome == validation::CutOutcome::stable;
   }
 }
 
-void write_history(const fs::path& file, const Trial& tr) {
-  std::string text = "t,u_c,kinetic\n";
-  for (std::size_t k = 0; k < tr.t.size(); ++k) {
-    text += fmt::format("{:.10g},{:.10g},{:.10g}\n", tr.t[k], tr.u[k], tr.ke[k]);
+void write_history(const Trial& tr) {
+  const fos::TrialHistory& h = tr.result.history;
+  // The monitor's samples, the energies interpolated to their times: the kinetic energy the
+  // classification reads, both sets' own, the plastic dissipation.
+  std::string text = "t,u_c,kinetic,kinetic_nodes,kinetic_stress_points,plastic_dissipation\n";
+  for (std::size_t k = 0; k < h.t.size(); ++k) {
+    text += fmt::format("{:.10g},{:.10g},{:.10g},{:.10g},{:.10g},{:.10g}\n", h.t[k], h.uc[k], tr.ke_at_t[k],
+                        interpolate(h.energy_t, h.kinetic, h.t[k]),
+                        interpolate(h.energy_t, h.kinetic_stress_points, h.t[k]),
+                        interpolate(h.energy_t, h.plastic, h.t[k]));
   }
-  io::write_file_atomically(file.string(), text, false);
+  io::write_file_atomically(tr.history_file.string(), text, false);
 }
 
 // Make the search's folder: new, empty, or the folder of an earlier search (whose trials go).
@@ -148,7 +121,7 @@ struct Scaling {
   fos::StrengthReduction strength;
   fos::LoadScaling load;
   bool by_load() const { return mode == fos::FactorMode::load; }
-  std::vector<std::string> overrides(double f) const { return by_load() ? load.overrides(f) : strength.overrides(f); }
+  void apply(toml::table& root, double f) const { by_load() ? load.apply(root, f) : strength.apply(root, f); }
   std::vector<std::pair<std::string, double>> values(double f) const {
     return by_load() ? load.values(f) : strength.values(f);
   }
@@ -157,10 +130,18 @@ struct Scaling {
   const char* key() const { return by_load() ? "load_factor" : "factor_of_safety"; }
 };
 
-nlohmann::json trial_json(const Trial& tr, const fs::path& out, const Scaling& scaling) {
-  const auto& c = tr.classification;
-  double u_max = 0.0;
-  for (double u : tr.u) u_max = std::max(u_max, u);
+// The plastic work done over [a, b] (J), from the energy history.
+double plastic_work(const fos::TrialHistory& h, double a, double b) {
+  return interpolate(h.energy_t, h.plastic, b) - interpolate(h.energy_t, h.plastic, a);
+}
+
+nlohmann::json finite_or_null(double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(nullptr); }
+
+nlohmann::json trial_json(const Trial& tr, const fs::path& out, const Scaling& scaling, const fos::Monitor& m) {
+  const fos::TrialResult& r = tr.result;
+  const fos::TrialHistory& h = r.history;
+  double u_max = h.uc.empty() ? 0.0 : h.uc.front();
+  for (double u : h.uc) u_max = std::max(u_max, u);
   nlohmann::json changed = nlohmann::json::object();
   for (const auto& [key, value] : scaling.values(tr.factor)) changed[key] = value;
   nlohmann::json j = {
@@ -169,21 +150,41 @@ nlohmann::json trial_json(const Trial& tr, const fs::path& out, const Scaling& s
       {"outcome", tr.outcome},
       {"stable", tr.stable},
       {"used", tr.used},
-      {"folder", fs::relative(tr.folder, out).string()},
-      {"history", fs::relative(tr.folder, out).string() + ".csv"},
+      {"history", fs::relative(tr.history_file, out).string()},
       {"exit_code", tr.exit_code},
-      {"seconds", tr.seconds},
+      {"seconds", r.seconds},
+      {"steps", r.steps},
+      {"t_end", r.end_time},
       {scaling.by_load() ? "scaled" : "reduced", changed},
-      {"u_c",
-       {{"end", c.uc_end},
-        {"max", u_max},
-        {"change_last_window", c.uc_change},
-        {"accelerating", c.accelerating},
-        {"samples", tr.t.size()},
-        {"t_end", tr.t.empty() ? 0.0 : tr.t.back()}}},
-      {"kinetic_ratio_last_window", c.ke_ratio},
   };
-  if (!tr.error.empty()) j["message"] = tr.error;
+  if (fs::exists(tr.frame_file)) j["frame"] = fs::relative(tr.frame_file, out).string();
+  if (scaling.by_load()) {
+    const auto& c = tr.classification;
+    j["u_c"] = {{"end", c.uc_end},
+                {"max", u_max},
+                {"change_last_window", c.uc_change},
+                {"accelerating", c.accelerating},
+                {"samples", h.t.size()}};
+    j["kinetic_ratio_last_window"] = c.ke_ratio;
+  } else {
+    const fos::HoldMeasures& hm = r.hold;
+    const double mid = m.hold_start + 0.5 * m.hold;
+    const double w1 = plastic_work(h, m.hold_start, std::min(mid, r.end_time));
+    const double w2 = r.end_time > mid ? plastic_work(h, mid, r.end_time) : 0.0;
+    j["hold"] = {{"drift_first_half", hm.first_half},
+                 {"drift_second_half", hm.second_half},
+                 {"ratio", finite_or_null(hm.ratio)},
+                 {"large_displacement", hm.large_displacement},
+                 {"decided_at", finite_or_null(hm.decided_at)},
+                 {"plastic_work_first_half", w1},
+                 {"plastic_work_second_half", w2}};
+    j["u_c"] = {{"end", hm.uc}, {"max", hm.uc_max}, {"samples", h.t.size()}};
+  }
+  if (!tr.error.empty()) {
+    j["message"] = tr.error;
+  } else if (!r.message.empty()) {
+    j["message"] = r.message;
+  }
   return j;
 }
 
@@ -209,36 +210,48 @@ int run_fos(const FosOptions& opt) {
     scaling.load = fos::read_load_scaling(doc, table);
   } else {
     scaling.strength = fos::read_strength(doc);
+    scaling.strength.rate_independent = table.rate_independent;
   }
   if (opt.tolerance > 0.0) table.search.tolerance = opt.tolerance;
   if (opt.max_trials > 0) table.search.max_trials = opt.max_trials;
   const fos::SearchSettings& settings = table.search;
   const fos::Monitor monitor = fos::resolve_monitor(doc, table);
+  const bool by_hold = !scaling.by_load();
   const std::string solver_version = [&] {
     const auto v = doc.table["solver"]["version"].value<std::string>();
     return v ? *v : std::string("v1");
   }();
+  // A trial's rule: strength reduction by the hold after time.end (app/fos_criterion.hpp), the
+  // load factor by the last window of the case's run (CASES.md §1.3).
+  fos::HoldRule hold_rule;
+  hold_rule.hold_start = monitor.hold_start;
+  hold_rule.hold = monitor.hold;
+  hold_rule.length = monitor.length;
 
   const fs::path out = opt.out_dir.empty() ? fs::path("out") / (fs::path(opt.case_file).stem().string() + "_fos")
                                            : fs::path(opt.out_dir);
   prepare_folder(out);
-  std::vector<std::string> base = case_overrides;
-  base.push_back("output.checkpoint_interval=0");  // the trials are not resumed
-  base.push_back(fos::monitor_probe_override(doc, monitor));
 
   const int threads = std::max(1, opt.threads);
   const int jobs = std::clamp(opt.jobs > 0 ? opt.jobs : threads, 1, 64);
   const int threads_per_trial = std::max(1, threads / jobs);
+  const std::string rule_text =
+      by_hold ? fmt::format("hold {:.4g} s after time.end = {:.4g} s ({}{})", monitor.hold, monitor.hold_start,
+                            monitor.time_scale > 0.0
+                                ? fmt::format("{:.3g} time scales sqrt(L/g) = {:.3g} s", monitor.hold / monitor.time_scale,
+                                              monitor.time_scale)
+                                : std::string("no gravity: the case's time.end"),
+                            scaling.strength.rate_independent ? "; materials rate-independent" : "; the case's fluidity")
+              : fmt::format("window {} s", monitor.window);
   if (!opt.quiet) {
     std::cerr << fmt::format(
-        "rktsph fos: {} ({}, dx = {:.4g} m, h = {:.4g} m), {}, monitor at [{}] along [{}] ({}), length {} m, window "
-        "{} s; tolerance {} on F, at most {} trials, {} at once ({} thread{} each)\n",
+        "rktsph fos: {} ({}, dx = {:.4g} m, h = {:.4g} m), {}, monitor at [{}] along [{}] ({}), length {} m, {}; "
+        "tolerance {} on F, at most {} trials, {} at once ({} thread{} each)\n",
         opt.case_file, solver_version, monitor.spacing, monitor.smoothing_length,
         scaling.by_load() ? fmt::format("load factor on {}", fmt::join(table.load_functions, ", "))
                           : std::string("strength reduction"),
         fmt::join(monitor.position, ", "), fmt::join(monitor.direction, ", "), monitor.source, monitor.length,
-        monitor.window, settings.tolerance, settings.max_trials, jobs, threads_per_trial,
-        threads_per_trial > 1 ? "s" : "");
+        rule_text, settings.tolerance, settings.max_trials, jobs, threads_per_trial, threads_per_trial > 1 ? "s" : "");
   }
 
   std::vector<Trial> trials;
@@ -273,11 +286,26 @@ int run_fos(const FosOptions& opt) {
     j["spacing"] = monitor.spacing;
     j["smoothing_length"] = monitor.smoothing_length;
     j["monitor"] = {{"position", monitor.position}, {"direction", monitor.direction},    {"length", monitor.length},
-                    {"window", monitor.window},     {"kinetic", monitor.kinetic_column}, {"source", monitor.source}};
-    j["classification"] =
-        "docs/cases.md §1.3 on u_c = u . direction at the monitored node, with H = length: stable if over the last "
-        "window u_c changes by less than 1e-3 H and the kinetic energy stays below 1e-2 of its peak; collapse if u_c "
-        "> 0.05 H or u_c still accelerates; otherwise undecided. Undecided and unstable trials count as not stable.";
+                    {"kinetic", monitor.kinetic_column}, {"source", monitor.source}};
+    if (by_hold) {
+      j["monitor"]["hold_start"] = monitor.hold_start;
+      j["monitor"]["hold"] = monitor.hold;
+      j["monitor"]["time_scale"] = monitor.time_scale;
+      j["rate_independent"] = scaling.strength.rate_independent;
+      j["classification"] = fmt::format(
+          "method-notes eq. (10.5): over the hold of {} s after time.end = {} s the monitored node drifts at v1 over "
+          "the first half and v2 over the second (least-squares slopes of its displacement); collapse if u_c > {} L "
+          "at any time, or if v2 h/2 > {} L and v2 >= {} v1 (the motion does not die out), otherwise stable. A trial "
+          "the solver stops counts as not stable.",
+          hold_rule.hold, hold_rule.hold_start, hold_rule.collapse, hold_rule.rest, hold_rule.decay);
+    } else {
+      j["monitor"]["window"] = monitor.window;
+      j["classification"] =
+          "docs/cases.md §1.3 on u_c = u . direction at the monitored node, with H = length: stable if over the last "
+          "window u_c changes by less than 1e-3 H and the kinetic energy stays below 1e-2 of its peak; collapse if "
+          "u_c > 0.05 H or u_c still accelerates; otherwise undecided. Undecided and unstable trials count as not "
+          "stable.";
+    }
     if (scaling.by_load()) {
       nlohmann::json loads = nlohmann::json::object();
       for (const auto& [table_name, scale] : scaling.load.functions) loads[table_name + ".scale"] = scale;
@@ -295,7 +323,7 @@ int run_fos(const FosOptions& opt) {
       j["unreduced_materials"] = scaling.strength.unreduced;
     }
     j["trials"] = nlohmann::json::array();
-    for (const Trial& tr : trials) j["trials"].push_back(trial_json(tr, out, scaling));
+    for (const Trial& tr : trials) j["trials"].push_back(trial_json(tr, out, scaling, monitor));
     j["wall_seconds"] = std::chrono::duration<double>(Clock::now() - t_start).count();
     io::write_file_atomically((out / "fos.json").string(), j.dump(2) + "\n");
   };
@@ -307,6 +335,7 @@ int run_fos(const FosOptions& opt) {
       tr.used = std::any_of(path.begin(), path.end(), [&](const fos::Step& s) { return s.factor == tr.factor; });
     }
   };
+  install_stop_handlers();
   auto evaluate = [&](const std::vector<double>& batch) {
     mark_used();
     status = fos::status_after(settings, path);
@@ -316,9 +345,8 @@ int run_fos(const FosOptions& opt) {
       Trial tr;
       tr.index = static_cast<int>(trials.size()) + 1;
       tr.factor = f;
-      tr.folder = out / fmt::format("trial_{:02d}", tr.index);
-      tr.overrides = base;
-      for (const std::string& o : scaling.overrides(f)) tr.overrides.push_back(o);
+      tr.history_file = out / fmt::format("trial_{:02d}.csv", tr.index);
+      tr.frame_file = out / fmt::format("trial_{:02d}.vtu", tr.index);
       trials.push_back(std::move(tr));
     }
     if (!opt.quiet) {
@@ -328,16 +356,24 @@ int run_fos(const FosOptions& opt) {
                                bracket_text(status), path.size(), settings.max_trials, first, fmt::join(fs_text, ", "),
                                batch.size() > 1 ? fmt::format(" ({} at once)", batch.size()) : std::string());
     }
+    // Each trial in process: the case's document at its factor, a Simulation, an observer of
+    // the monitored node (app/fos_trial.hpp).
     auto run_one = [&](Trial& tr) {
-      const auto t0 = Clock::now();
-      RunOptions ro;
-      ro.case_file = opt.case_file;
-      ro.out_dir = tr.folder.string();
-      ro.overrides = tr.overrides;
-      ro.threads = threads_per_trial;
-      ro.quiet = true;
       try {
-        tr.exit_code = run_case(ro);
+        CaseDocument trial_doc = doc;
+        scaling.apply(trial_doc.table, tr.factor);
+        fos::TrialSpec spec;
+        spec.document = &trial_doc;
+        spec.monitor = monitor;
+        if (by_hold) {
+          spec.hold = hold_rule;
+          // The run continues past the case's time.end through the hold.
+          trial_doc.table["time"].as_table()->insert_or_assign("end", hold_rule.end());
+        }
+        spec.threads = threads_per_trial;
+        spec.frame = tr.frame_file;
+        tr.result = fos::run_trial(spec);
+        tr.exit_code = tr.result.exit_code;
       } catch (const InputError& e) {
         tr.exit_code = kExitInput;
         tr.error = e.what();
@@ -348,7 +384,6 @@ int run_fos(const FosOptions& opt) {
         tr.exit_code = 1;
         tr.error = e.what();
       }
-      tr.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
     };
     if (batch.size() == 1) {
       run_one(trials[first]);
@@ -373,13 +408,21 @@ int run_fos(const FosOptions& opt) {
         tr.outcome = "failed";
         continue;
       }
-      classify(tr, monitor);
-      write_history(tr.folder.string() + ".csv", tr);
+      classify(tr, monitor, by_hold);
+      write_history(tr);
       stable.push_back(tr.stable);
       if (!opt.quiet) {
-        std::cerr << fmt::format("fos: trial {} F = {:.4f}: {} (u_c = {:.4g} m = {:.3g} L, {:.1f} s)\n", tr.index,
-                                 tr.factor, tr.outcome, tr.classification.uc_end,
-                                 tr.classification.uc_end / monitor.length, tr.seconds);
+        const fos::TrialResult& r = tr.result;
+        const std::string measures =
+            by_hold ? fmt::format("v2/v1 = {:.3g} ({:.3g} / {:.3g} m/s), u_c = {:.4g} m = {:.3g} L{}", r.hold.ratio,
+                                  r.hold.second_half, r.hold.first_half, r.hold.uc, r.hold.uc / monitor.length,
+                                  std::isfinite(r.hold.decided_at) && r.hold.decided_at < hold_rule.end() - 1e-9
+                                      ? fmt::format(", decided at t = {:.3g} s", r.hold.decided_at)
+                                      : std::string())
+                    : fmt::format("u_c = {:.4g} m = {:.3g} L", tr.classification.uc_end,
+                                  tr.classification.uc_end / monitor.length);
+        std::cerr << fmt::format("fos: trial {} F = {:.4f}: {} ({}; {:.1f} s)\n", tr.index, tr.factor, tr.outcome,
+                                 measures, r.seconds);
       }
     }
     if (!failure.empty()) throw TrialFailure{};
@@ -415,17 +458,19 @@ int run_fos(const FosOptions& opt) {
                             scaling.name(), status.factor(), status.lo, status.hi, settings.tolerance, path.size(),
                             trials.size());
       break;
-    case fos::SearchState::unreduced_fails:
+    case fos::SearchState::unreduced_fails: {
+      const double uc = by_hold ? first_trial->result.hold.uc : first_trial->classification.uc_end;
       message = fmt::format(
           "rktsph fos: the {} (F = {}) does not stand: trial 1 is {} (u_c = {:.4g} m = {:.3g} L at the end); {}; "
-          "the trial is kept in {}",
-          scaling.by_load() ? "case at its nominal load" : "unreduced case", settings.start, first_trial->outcome,
-          first_trial->classification.uc_end, first_trial->classification.uc_end / monitor.length,
+          "its history is kept in {}",
+          scaling.by_load() ? "case at its nominal load" : "unreduced case", settings.start, first_trial->outcome, uc,
+          uc / monitor.length,
           scaling.by_load() ? "the load factor is searched from F = 1 up: give a nominal load the body carries"
                             : "strength reduction looks for F >= 1 only",
-          first_trial->folder.string());
+          first_trial->history_file.string());
       code = kExitNoFactor;
       break;
+    }
     default:
       message = fmt::format(
           "rktsph fos: the bracket {} did not close to the tolerance {} within {} trials{}; raise --max-trials{}; the "

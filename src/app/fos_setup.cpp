@@ -4,7 +4,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
-#include <sstream>
+#include <stdexcept>
 
 #include <fmt/format.h>
 #include <fmt/ranges.h>
@@ -14,19 +14,6 @@
 #include "schemes/simulation.hpp"
 
 namespace rktsph::fos {
-
-namespace {
-
-/// A trial's values reach the case through `--set TABLE.NAME.KEY`, which splits keys at dots: a
-/// name with a dot could not be overridden, so it is refused where it is named.
-void refuse_dotted_name(const io::Section& section, const std::string& key, const char* kind, const std::string& name) {
-  if (name.find('.') == std::string::npos) return;
-  section.fail(key, fmt::format("rktsph fos: the {} name '{}' has a dot: it cannot be overridden (--set splits "
-                                "keys at dots)",
-                                kind, name));
-}
-
-}  // namespace
 
 double reduced_friction_angle(double phi_degrees, double factor) {
   constexpr double kDeg = std::numbers::pi / 180.0;
@@ -50,17 +37,33 @@ std::vector<std::pair<std::string, double>> StrengthReduction::values(double fac
 
 namespace {
 
-/// The --set overrides "KEY=VALUE" of a trial's values: the shortest text that reads back as the
-/// same double (an integer-looking one is a TOML integer, which the reader takes as a number too).
-std::vector<std::string> as_overrides(const std::vector<std::pair<std::string, double>>& values) {
-  std::vector<std::string> out;
-  for (const auto& [key, value] : values) out.push_back(fmt::format("{}={}", key, value));
-  return out;
+/// The table `path` of a case's document, which the reader has already checked to be there:
+/// "material", or "materials.NAME" / "functions.NAME" (NAME may hold dots).
+toml::table& table_at(toml::table& root, const std::string& path) {
+  const std::size_t dot = path.find('.');
+  toml::table* t = root[path.substr(0, dot)].as_table();
+  if (t != nullptr && dot != std::string::npos) t = (*t)[path.substr(dot + 1)].as_table();
+  if (t == nullptr) throw std::logic_error("fos: no table " + path + " in the case");
+  return *t;
+}
+
+// "table.key" -> (table, key): the key is the part after the last dot.
+void set_value(toml::table& root, const std::string& dotted, double value) {
+  const std::size_t dot = dotted.rfind('.');
+  table_at(root, dotted.substr(0, dot)).insert_or_assign(dotted.substr(dot + 1), value);
 }
 
 }  // namespace
 
-std::vector<std::string> StrengthReduction::overrides(double factor) const { return as_overrides(values(factor)); }
+void StrengthReduction::apply(toml::table& root, double factor) const {
+  for (const auto& [key, value] : values(factor)) set_value(root, key, value);
+  if (!rate_independent) return;
+  // The rate-independent limit of each reduced Perzyna model (method-notes §2.5): the return
+  // mapping of the same surface and flow rule.
+  for (const MaterialStrength& m : materials) {
+    table_at(root, m.table).insert_or_assign("fluidity", std::numeric_limits<double>::infinity());
+  }
+}
 
 std::vector<std::pair<std::string, double>> LoadScaling::values(double factor) const {
   // method-notes eq. (10.4): every load a named function scales, times F.
@@ -69,7 +72,9 @@ std::vector<std::pair<std::string, double>> LoadScaling::values(double factor) c
   return out;
 }
 
-std::vector<std::string> LoadScaling::overrides(double factor) const { return as_overrides(values(factor)); }
+void LoadScaling::apply(toml::table& root, double factor) const {
+  for (const auto& [key, value] : values(factor)) set_value(root, key, value);
+}
 
 namespace {
 
@@ -123,10 +128,7 @@ StrengthReduction read_strength(const CaseDocument& doc) {
     add_material(root.table("material"), out);
   } else {
     const io::Section ms = root.table("materials");
-    for (const std::string& name : ms.keys()) {
-      refuse_dotted_name(ms, name, "material", name);
-      add_material(ms.table(name), out);
-    }
+    for (const std::string& name : ms.keys()) add_material(ms.table(name), out);
   }
   if (out.materials.empty()) {
     const std::string table = out.unreduced.empty() ? "material" : out.unreduced.front();
@@ -180,7 +182,23 @@ FosTable read_fos_table(const CaseDocument& doc) {
     f.direction = d;
   }
   if (s->has("length")) f.length = s->positive("length");
-  f.window = s->positive("window", 1.0);
+  // Each rule has its own keys: a key of the other mode is a mistake, said as such.
+  if (f.mode == FactorMode::load) {
+    f.window = s->positive("window", 1.0);
+    for (const char* key : {"hold", "rate_independent"}) {
+      if (s->has(key)) {
+        s->fail(key, "a strength-reduction key: the load factor keeps the case's materials and classifies the "
+                     "last fos.window seconds of each trial (docs/fos.md, \"The load factor\")");
+      }
+    }
+  } else {
+    if (s->has("window")) {
+      s->fail("window", "the load factor's classification window: a strength-reduction trial is judged over the "
+                        "hold that follows time.end, fos.hold (s; docs/fos.md, \"The classification\")");
+    }
+    if (s->has("hold")) f.hold = s->positive("hold");
+    f.rate_independent = s->boolean("rate_independent", true);
+  }
   const std::string kinetic = s->string("kinetic", "auto");
   if (kinetic == "stress_points" || kinetic == "nodes") {
     f.kinetic_of_stress_points = kinetic == "stress_points";
@@ -213,7 +231,6 @@ LoadScaling read_load_scaling(const CaseDocument& doc, const FosTable& table) {
                       "[functions.NAME] table and `function = \"NAME\"` on its [[boundary]] entries",
                       name, names.empty() ? std::string("none") : fmt::format("{}", fmt::join(names, ", "))));
     }
-    refuse_dotted_name(root.table("fos"), "load_functions", "function", name);
     const io::Section f = functions->table(name);
     const double scale = number_of(f.raw(), "scale").value_or(1.0);
     out.functions.emplace_back("functions." + name, scale);
@@ -242,7 +259,7 @@ Monitor resolve(const CaseDocument& doc, const FosTable& f) {
   m.kinetic_column = stress_points ? "kinetic_stress_points" : "kinetic";
   m.spacing = setup.dx;
   m.smoothing_length = setup.smoothing_length();
-  if (!(f.window < setup.end_time)) {
+  if (f.mode == FactorMode::load && !(f.window < setup.end_time)) {
     fail("window", fmt::format("the classification window ({} s) must be shorter than time.end ({} s)", f.window,
                                setup.end_time));
   }
@@ -331,6 +348,13 @@ Monitor resolve(const CaseDocument& doc, const FosTable& f) {
     m.length = hi - lo;
     if (!(m.length > 0.0)) fail("length", "the body has no height: give fos.length (m)");
   }
+  // The hold of a strength-reduction trial (app/fos_criterion.hpp): after the case's time.end,
+  // by default kHoldTimeScales time scales sqrt(L/g) of the body; without gravity the case's own
+  // duration, the time its author gave the loads to settle.
+  m.hold_start = setup.end_time;
+  const double g = setup.gravity.norm();
+  m.time_scale = g > 0.0 ? std::sqrt(m.length / g) : 0.0;
+  m.hold = f.hold.value_or(g > 0.0 ? kHoldTimeScales * m.time_scale : setup.end_time);
   return m;
 }
 
@@ -341,33 +365,6 @@ Monitor resolve_monitor(const CaseDocument& doc, const FosTable& table) {
   if (dim == 1) return resolve<1>(doc, table);
   if (dim == 3) return resolve<3>(doc, table);
   return resolve<2>(doc, table);
-}
-
-std::string monitor_probe_override(const CaseDocument& doc, const Monitor& monitor) {
-  toml::array probes;
-  if (const toml::array* existing = doc.table["probe"].as_array()) {
-    for (const toml::node& p : *existing) {
-      if (const toml::table* t = p.as_table()) {
-        if (t->get("name") != nullptr && t->get("name")->value<std::string>() == kMonitorProbe) {
-          throw InputError(fmt::format("{}: the probe name '{}' is reserved for rktsph fos",
-                                       io::Section(*t, "probe", doc.file_label).where("name"), kMonitorProbe));
-        }
-      }
-      probes.push_back(p);
-    }
-  }
-  toml::array position, fields;
-  for (double v : monitor.position) position.push_back(v);
-  // One displacement component per axis: ux, uy, uz.
-  for (std::size_t d = 0; d < monitor.position.size(); ++d) fields.push_back(fmt::format("u{}", kAxisNames[d]));
-  toml::table probe;
-  probe.insert("name", kMonitorProbe);
-  probe.insert("position", std::move(position));
-  probe.insert("fields", std::move(fields));
-  probes.push_back(std::move(probe));
-  std::ostringstream text;
-  text << probes;
-  return "probe=" + text.str();
 }
 
 }  // namespace rktsph::fos

@@ -72,9 +72,17 @@ int run_lem(const LemOptions& o) {
   for (const lem::Body& b : g.bodies()) {
     nlohmann::json holes = nlohmann::json::array();
     for (const auto& h : b.holes) holes.push_back(ring_json(h));
-    bodies.push_back({{"name", b.name}, {"outer", ring_json(b.outer)}, {"holes", holes}});
+    nlohmann::json body = {{"name", b.name}, {"outer", ring_json(b.outer)}, {"holes", holes}};
+    if (b.soil) {
+      body["material"] = b.material;
+      body["cohesion_Pa"] = b.soil->cohesion;
+      body["friction_angle_deg"] = b.soil->friction_angle * kDeg;
+      body["unit_weight_N_per_m3"] = b.soil->unit_weight;
+    }
+    bodies.push_back(body);
   }
   j["bodies"] = bodies;
+  j["layered"] = g.layered();  // true: "soil" is the first body's; each body gives its own
   nlohmann::json rigid = nlohmann::json::array();
   for (const lem::RigidRegion& rr : g.rigid_regions()) {
     rigid.push_back({{"name", rr.name},
@@ -128,6 +136,8 @@ int run_lem(const LemOptions& o) {
                       {"height", s.height},
                       {"alpha_deg", s.alpha * kDeg},
                       {"weight_N_per_m", s.weight},
+                      {"base_cohesion_Pa", s.cohesion},
+                      {"base_friction_angle_deg", std::atan(s.tan_phi) * kDeg},
                       {"base_length", s.base_length},
                       {"m_alpha", s.m_alpha},
                       {"m_alpha_limited", s.m_alpha_limited}});
@@ -142,6 +152,13 @@ int run_lem(const LemOptions& o) {
                c.factor, o.search.bishop.slices, c.fellenius, r.circle.centre.x, r.circle.centre.y, r.circle.radius,
                c.entry.x, c.entry.y, c.exit.x, c.exit.y, r.circles_evaluated, r.circles_valid, r.final_spacing_x,
                r.final_spacing_y);
+    if (g.layered()) {
+      for (const lem::Body& b : g.bodies()) {
+        if (!b.soil) continue;
+        fmt::print("     {}: '{}', c = {:.4g} kPa, phi = {:.4g} deg, gamma = {:.4g} kN/m^3\n", b.name, b.material,
+                   b.soil->cohesion / 1e3, b.soil->friction_angle * kDeg, b.soil->unit_weight / 1e3);
+      }
+    }
     for (const std::string& n : problem.notes) fmt::print("note: {}\n", n);
     if (on_edge) fmt::print("warning: the critical centre lies near the edge of the first search box\n");
     fmt::print("wrote {}\n", json_file);

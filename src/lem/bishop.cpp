@@ -20,24 +20,31 @@ const char* rejection_name(Rejection r) {
   return "unknown";
 }
 
-double fellenius_factor(const std::vector<Slice>& slices, const Soil& soil) {
+double fellenius_factor(const std::vector<Slice>& slices) {
   // Eq. (9.3): F = sum(c l + W cos(alpha) tan(phi)) / sum(W sin(alpha)).
-  const double tan_phi = std::tan(soil.friction_angle);
   double resisting = 0.0, driving = 0.0;
   for (const Slice& s : slices) {
-    resisting += soil.cohesion * s.base_length + s.weight * std::cos(s.alpha) * tan_phi;
+    resisting += s.cohesion * s.base_length + s.weight * std::cos(s.alpha) * s.tan_phi;
     driving += s.weight * std::sin(s.alpha);
   }
   return resisting / driving;
 }
 
-std::optional<double> bishop_factor(std::vector<Slice>& slices, const Soil& soil, const BishopOptions& options,
-                                    int* iterations, std::size_t* limited) {
-  const double tan_phi = std::tan(soil.friction_angle);
+double fellenius_factor(const std::vector<Slice>& slices, const Soil& soil) {
+  std::vector<Slice> with = slices;
+  for (Slice& s : with) {
+    s.cohesion = soil.cohesion;
+    s.tan_phi = std::tan(soil.friction_angle);
+  }
+  return fellenius_factor(with);
+}
+
+std::optional<double> bishop_factor(std::vector<Slice>& slices, const BishopOptions& options, int* iterations,
+                                    std::size_t* limited) {
   double driving = 0.0;
   for (const Slice& s : slices) driving += s.weight * std::sin(s.alpha);
   if (!(driving > 0.0)) return std::nullopt;
-  double F = fellenius_factor(slices, soil);
+  double F = fellenius_factor(slices);
   if (!(F > 0.0) || !std::isfinite(F)) F = 1.0;
   for (int it = 1; it <= options.max_iterations; ++it) {
     // Eq. (9.2) with m_alpha of eq. (9.5) at the previous F; the floor of eq. (9.6) only on the
@@ -45,14 +52,14 @@ std::optional<double> bishop_factor(std::vector<Slice>& slices, const Soil& soil
     double resisting = 0.0;
     std::size_t n_limited = 0;
     for (Slice& s : slices) {
-      double m = std::cos(s.alpha) + std::sin(s.alpha) * tan_phi / F;
+      double m = std::cos(s.alpha) + std::sin(s.alpha) * s.tan_phi / F;
       s.m_alpha_limited = s.alpha < 0.0 && m < options.m_alpha_floor;
       if (s.m_alpha_limited) {
         m = options.m_alpha_floor;
         ++n_limited;
       }
       s.m_alpha = m;
-      resisting += (soil.cohesion * s.width + s.weight * tan_phi) / m;
+      resisting += (s.cohesion * s.width + s.weight * s.tan_phi) / m;
     }
     const double next = resisting / driving;
     const bool done = std::abs(next - F) <= options.tolerance * next;
@@ -64,6 +71,15 @@ std::optional<double> bishop_factor(std::vector<Slice>& slices, const Soil& soil
     }
   }
   return std::nullopt;
+}
+
+std::optional<double> bishop_factor(std::vector<Slice>& slices, const Soil& soil, const BishopOptions& options,
+                                    int* iterations, std::size_t* limited) {
+  for (Slice& s : slices) {
+    s.cohesion = soil.cohesion;
+    s.tan_phi = std::tan(soil.friction_angle);
+  }
+  return bishop_factor(slices, options, iterations, limited);
 }
 
 CircleResult evaluate_circle(const SoilGeometry& g, const Soil& soil, const Circle& circle,
@@ -112,7 +128,10 @@ CircleResult evaluate_circle(const SoilGeometry& g, const Soil& soil, const Circ
     const double dx = s.x - c.x;
     s.base_y = c.y - std::sqrt(std::max(0.0, R * R - dx * dx));
     s.height = g.soil_above(s.x, s.base_y);  // eq. (9.4)
-    s.weight = soil.unit_weight * b * s.height;
+    s.weight = b * g.weight_above(s.x, s.base_y, soil);
+    const Soil base = g.soil_at({s.x, s.base_y}, soil);
+    s.cohesion = base.cohesion;
+    s.tan_phi = std::tan(base.friction_angle);
     s.alpha = std::asin(std::clamp(dx / R, -1.0, 1.0));
     moment += s.weight * dx;
   }
@@ -127,13 +146,13 @@ CircleResult evaluate_circle(const SoilGeometry& g, const Soil& soil, const Circ
     s.alpha *= sense;
     s.base_length = s.width / std::cos(s.alpha);
   }
-  const auto F = bishop_factor(slices, soil, options, &out.iterations, &out.limited_slices);
+  const auto F = bishop_factor(slices, options, &out.iterations, &out.limited_slices);
   if (!F) {
     out.rejection = Rejection::not_converged;
     return out;
   }
   out.factor = *F;
-  out.fellenius = fellenius_factor(slices, soil);
+  out.fellenius = fellenius_factor(slices);
   const Point left = crossings[0].p, right = crossings[1].p;
   out.entry = out.direction < 0 ? right : left;
   out.exit = out.direction < 0 ? left : right;

@@ -11,13 +11,6 @@
 
 namespace rktsph::lem {
 
-/// The Mohr-Coulomb strength and weight of the soil: tau_f = c + sigma_n tan(phi).
-struct Soil {
-  double cohesion = 0.0;        // Pa
-  double friction_angle = 0.0;  // rad
-  double unit_weight = 0.0;     // N/m^3
-};
-
 struct Circle {
   Point centre;
   double radius = 0.0;
@@ -30,6 +23,8 @@ struct Slice {
   double height = 0.0;      // m, soil above the base at x
   double alpha = 0.0;       // rad, base inclination: > 0 where the base descends in the direction of sliding
   double weight = 0.0;      // N/m
+  double cohesion = 0.0;    // Pa, of the soil at the base
+  double tan_phi = 0.0;     // of the soil at the base
   double base_length = 0.0; // m, width / cos(alpha)
   double m_alpha = 0.0;     // cos(alpha) + sin(alpha) tan(phi) / F, after the safeguard
   bool m_alpha_limited = false;
@@ -67,14 +62,22 @@ struct BishopOptions {
 };
 
 /// Slices (equal widths between the entry and the exit) and F of one circle (eqs. (9.1)-(9.6)).
+/// `soil` is that of the bodies without their own; a slice weighs each body above its base with
+/// that body's unit weight and takes c and phi of the body its base lies in.
 CircleResult evaluate_circle(const SoilGeometry& soil_geometry, const Soil& soil, const Circle& circle,
                              const BishopOptions& options, bool keep_slices = false);
 
 /// The F of given slices by Bishop's simplified method, eq. (9.2), by fixed-point iteration from
-/// the ordinary method's value; fills each slice's m_alpha. `iterations` receives the count.
+/// the ordinary method's value, with each slice's own cohesion and tan_phi; fills each slice's
+/// m_alpha. `iterations` receives the count.
+std::optional<double> bishop_factor(std::vector<Slice>& slices, const BishopOptions& options, int* iterations,
+                                    std::size_t* limited);
+/// The same with one soil for every slice (its c and phi written into them).
 std::optional<double> bishop_factor(std::vector<Slice>& slices, const Soil& soil, const BishopOptions& options,
                                     int* iterations, std::size_t* limited);
-/// The ordinary method of slices (Fellenius), eq. (9.3).
+/// The ordinary method of slices (Fellenius), eq. (9.3), with each slice's cohesion and tan_phi.
+double fellenius_factor(const std::vector<Slice>& slices);
+/// The same with one soil for every slice.
 double fellenius_factor(const std::vector<Slice>& slices, const Soil& soil);
 
 struct SearchOptions {

@@ -157,18 +157,11 @@ LemProblem read_lem_problem(const CaseDocument& doc) {
     return *strengths[index];
   };
 
-  // ---- bodies: polygons and blocks, one soil
+  // ---- bodies: polygons and blocks, each with its material's soil
   std::vector<Body> bodies;
-  const MaterialStrength* soil = nullptr;
+  std::vector<const MaterialStrength*> body_material;
   auto add_body = [&](const io::Section& s, Body body) {
-    const MaterialStrength& m = material_of(s);
-    if (soil != nullptr && (m.cohesion != soil->cohesion || m.friction_angle != soil->friction_angle ||
-                            m.density != soil->density)) {
-      s.fail("material", fmt::format("the limit-equilibrium analysis takes one soil, but material '{}' differs from "
-                                     "'{}' in c, phi or density",
-                                     m.name, soil->name));
-    }
-    soil = &m;
+    body_material.push_back(&material_of(s));
     body.name = s.path();
     bodies.push_back(std::move(body));
   };
@@ -185,7 +178,8 @@ LemProblem read_lem_problem(const CaseDocument& doc) {
       if (holes == nullptr) p.fail("holes", "must be an array of rings, each an array of [x, y] points");
       for (std::size_t h = 0; h < holes->size(); ++h) {
         std::vector<Point> ring = read_ring(p, "holes", *holes->get(h), fmt::format("hole {}", h));
-        Body outer_only{body.outer, {}, ""};
+        Body outer_only;
+        outer_only.outer = body.outer;
         for (const Point& q : ring) {
           if (!SoilGeometry({outer_only}, {}).contains(q)) {
             p.fail("holes", fmt::format("hole {}: a point ({}, {}) lies outside the polygon's vertices", h, q.x, q.y));
@@ -221,11 +215,17 @@ LemProblem read_lem_problem(const CaseDocument& doc) {
 
   LemProblem out{SoilGeometry({}, {}), {}, {}, {}, {}, {}, {}, {}};
   out.title = root.string("title", "");
+  const MaterialStrength* soil = body_material.front();  // the first body's, for the summary
   out.material_name = soil->name;
   out.model = soil->model;
   out.density = soil->density;
   out.gravity = -gravity[1];
   out.soil = {soil->cohesion, soil->friction_angle, soil->density * out.gravity};
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    const MaterialStrength& m = *body_material[i];
+    bodies[i].soil = Soil{m.cohesion, m.friction_angle, m.density * out.gravity};
+    bodies[i].material = m.name;
+  }
   if (bf->has("function")) {
     out.notes.push_back("body_force.function is not applied: the analysis takes the full gravity");
   }

@@ -102,28 +102,34 @@ bool SoilGeometry::on_rigid(Point p) const {
   });
 }
 
+namespace {
+
+// A body's sections on the vertical at x: the even-odd pairing of its edges' heights (half-open
+// in x, so a vertex is counted once and a vertical edge not at all), as (lo, hi) from y up.
+void body_sections(const Body& b, double x, double y, std::vector<double>& heights,
+                   std::vector<std::pair<double, double>>& out) {
+  heights.clear();
+  for_each_ring(b, [&](const std::vector<Point>& r) {
+    const std::size_t n = r.size();
+    for (std::size_t i = 0; i < n; ++i) {
+      const Point a = r[i], c = r[(i + 1) % n];
+      if ((a.x <= x && x < c.x) || (c.x <= x && x < a.x)) heights.push_back(a.y + (x - a.x) * (c.y - a.y) / (c.x - a.x));
+    }
+  });
+  std::sort(heights.begin(), heights.end());
+  for (std::size_t k = 0; k + 1 < heights.size(); k += 2) {
+    const double lo = std::max(heights[k], y), hi = heights[k + 1];
+    if (hi > lo) out.emplace_back(lo, hi);
+  }
+}
+
+}  // namespace
+
 double SoilGeometry::soil_above(double x, double y) const {
-  // Each body's section is the even-odd pairing of its edges' heights at x (half-open in x, so
-  // a vertex is counted once and a vertical edge not at all); the bodies' sections are merged.
+  // The bodies' sections merged (overlapping or touching bodies count once).
   std::vector<std::pair<double, double>> intervals;
   std::vector<double> heights;
-  for (const Body& b : bodies_) {
-    heights.clear();
-    for_each_ring(b, [&](const std::vector<Point>& r) {
-      const std::size_t n = r.size();
-      for (std::size_t i = 0; i < n; ++i) {
-        const Point a = r[i], c = r[(i + 1) % n];
-        if ((a.x <= x && x < c.x) || (c.x <= x && x < a.x)) {
-          heights.push_back(a.y + (x - a.x) * (c.y - a.y) / (c.x - a.x));
-        }
-      }
-    });
-    std::sort(heights.begin(), heights.end());
-    for (std::size_t k = 0; k + 1 < heights.size(); k += 2) {
-      const double lo = std::max(heights[k], y), hi = heights[k + 1];
-      if (hi > lo) intervals.emplace_back(lo, hi);
-    }
-  }
+  for (const Body& b : bodies_) body_sections(b, x, y, heights, intervals);
   std::sort(intervals.begin(), intervals.end());
   double length = 0.0, top = -std::numeric_limits<double>::infinity();
   for (const auto& [lo, hi] : intervals) {
@@ -132,6 +138,57 @@ double SoilGeometry::soil_above(double x, double y) const {
     top = std::max(top, hi);
   }
   return length;
+}
+
+bool SoilGeometry::layered() const {
+  for (const Body& b : bodies_) {
+    const Body& first = bodies_.front();
+    if (b.soil.has_value() != first.soil.has_value()) return true;
+    if (b.soil && (b.soil->cohesion != first.soil->cohesion || b.soil->friction_angle != first.soil->friction_angle ||
+                   b.soil->unit_weight != first.soil->unit_weight)) {
+      return true;
+    }
+  }
+  return false;
+}
+
+double SoilGeometry::weight_above(double x, double y, const Soil& fallback) const {
+  if (!layered()) return (bodies_.empty() ? fallback : bodies_.front().soil.value_or(fallback)).unit_weight * soil_above(x, y);
+  // Each piece between the sections' ends weighs with the last body covering it.
+  std::vector<std::pair<double, double>> sections;
+  std::vector<std::size_t> owner;
+  std::vector<double> heights;
+  for (std::size_t i = 0; i < bodies_.size(); ++i) {
+    body_sections(bodies_[i], x, y, heights, sections);
+    owner.resize(sections.size(), i);
+  }
+  std::vector<double> cuts;
+  for (const auto& [lo, hi] : sections) {
+    cuts.push_back(lo);
+    cuts.push_back(hi);
+  }
+  std::sort(cuts.begin(), cuts.end());
+  double weight = 0.0;
+  for (std::size_t k = 0; k + 1 < cuts.size(); ++k) {
+    const double mid = 0.5 * (cuts[k] + cuts[k + 1]);
+    if (!(cuts[k + 1] > cuts[k])) continue;
+    for (std::size_t j = sections.size(); j-- > 0;) {
+      if (sections[j].first <= mid && mid <= sections[j].second) {
+        weight += bodies_[owner[j]].soil.value_or(fallback).unit_weight * (cuts[k + 1] - cuts[k]);
+        break;
+      }
+    }
+  }
+  return weight;
+}
+
+Soil SoilGeometry::soil_at(Point p, const Soil& fallback) const {
+  if (!layered()) return bodies_.empty() ? fallback : bodies_.front().soil.value_or(fallback);
+  const Point q{p.x, p.y + 1e-6 * size_};  // just above: a base on a seam takes the body above it
+  for (std::size_t i = bodies_.size(); i-- > 0;) {
+    if (body_contains(bodies_[i], q)) return bodies_[i].soil.value_or(fallback);
+  }
+  return fallback;
 }
 
 std::vector<Crossing> SoilGeometry::lower_crossings(Point centre, double radius) const {

@@ -5,6 +5,7 @@
 // sections, so overlapping or touching bodies (a union of blocks) need no outline merging.
 #include <array>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -15,11 +16,21 @@ struct Point {
   double y = 0.0;
 };
 
+/// The Mohr-Coulomb strength and weight of a soil: tau_f = c + sigma_n tan(phi).
+struct Soil {
+  double cohesion = 0.0;        // Pa
+  double friction_angle = 0.0;  // rad
+  double unit_weight = 0.0;     // N/m^3
+};
+
 /// One body: its outer ring (counter-clockwise, not repeated at the end) and its holes.
 struct Body {
   std::vector<Point> outer;
   std::vector<std::vector<Point>> holes;
   std::string name;  // for messages and the plot
+  /// Its own soil (a layered slope); absent: the soil the analysis is given.
+  std::optional<Soil> soil;
+  std::string material;  // the soil's [materials.NAME], for the output
 };
 
 /// A region a slip surface may not cross: a box, each axis bounded or not (a [[boundary]] entry
@@ -53,6 +64,15 @@ class SoilGeometry {
   bool contains(Point p) const;
   /// Length of soil on the vertical line at x above the height y (eq. (9.4)).
   double soil_above(double x, double y) const;
+  /// Weight per unit width of the soil on the vertical line at x above y: each body's length
+  /// times its unit weight (`fallback` for a body without a soil). Where bodies overlap the
+  /// later one counts, as the particle case's blocks give the later block's material.
+  double weight_above(double x, double y, const Soil& fallback) const;
+  /// The soil just above p (a slice's base): the last body containing it; `fallback` where that
+  /// body has no soil or none contains it.
+  Soil soil_at(Point p, const Soil& fallback) const;
+  /// Whether the bodies carry more than one soil.
+  bool layered() const;
   /// The crossings of the circle (centre, radius) with the boundary of the union whose height
   /// is below the centre (its lower half), seams between touching bodies left out, coincident
   /// crossings (a vertex) merged; sorted by x.

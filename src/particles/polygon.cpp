@@ -257,9 +257,11 @@ struct Face {
 struct EdgeNode {
   P x;
   int body = 0;
+  std::vector<int> also;  // other bodies touching here (a seam); `body` is the last of them
   std::vector<Face> faces;
   bool vertex = false;
   bool convex = true;  // at a vertex: the boundary turns towards the body's side (left)
+  bool merged = false;  // folded into another body's node at the same point
 };
 
 bool axis_aligned(const P& n) { return n[0] == 0.0 || n[1] == 0.0; }
@@ -468,19 +470,87 @@ LatticeParticles<2> generate_polygon_particles(const std::vector<PolygonBody>& b
     }
   }
 
+  // Touching bodies (a layer): their nodes at one point of a seam become one node with the
+  // faces of both, of the material a lattice gives it (its first cell in the lattice's order
+  // that holds a body: below, then left), so that layers on the lattice are their blocks. A
+  // seam's faces, opposite normals from two bodies, cancel (the part left over is the union's
+  // boundary), so a node inside the union is on no face; faces along one line join.
+  {
+    std::vector<std::size_t> by_x(edge_nodes.size());
+    std::iota(by_x.begin(), by_x.end(), std::size_t{0});
+    std::sort(by_x.begin(), by_x.end(), [&](std::size_t a, std::size_t b) { return edge_nodes[a].x[0] < edge_nodes[b].x[0]; });
+    for (std::size_t u = 0; u < by_x.size(); ++u) {
+      EdgeNode& a = edge_nodes[by_x[u]];
+      if (a.merged) continue;
+      for (std::size_t w = u + 1; w < by_x.size() && edge_nodes[by_x[w]].x[0] - a.x[0] <= snap; ++w) {
+        EdgeNode& b = edge_nodes[by_x[w]];
+        if (b.merged || b.body == a.body || std::abs(b.x[1] - a.x[1]) > snap) continue;
+        a.also.push_back(b.body);
+        a.faces.insert(a.faces.end(), b.faces.begin(), b.faces.end());
+        a.vertex = a.vertex || b.vertex;
+        b.merged = true;
+      }
+    }
+    for (EdgeNode& e : edge_nodes) {
+      if (e.merged || e.also.empty()) continue;
+      for (const P& off : {P(-1, -1), P(1, -1), P(-1, 1), P(1, 1)}) {
+        const P q = e.x + 1e-6 * dx * off;
+        const int i = static_cast<int>(std::floor((q[0] - lat.origin[0]) / dx));
+        const int j = static_cast<int>(std::floor((q[1] - lat.origin[1]) / dx));
+        if (i < 0 || i >= nx || j < 0 || j >= ny) continue;
+        const int b = body_of[lat.cell_index({i, j})];
+        const auto it = std::find(e.also.begin(), e.also.end(), b);
+        if (b == e.body) break;
+        if (it != e.also.end()) {
+          *it = e.body;
+          e.body = b;
+          break;
+        }
+      }
+      std::vector<Face> net;
+      for (Face f : e.faces) {
+        for (Face& g : net) {
+          if (f.length <= 0.0) break;
+          const double c = f.normal.dot(g.normal);
+          if (c < -1.0 + 1e-12) {  // a seam: the shorter share cancels
+            const double t = std::min(f.length, g.length);
+            f.length -= t;
+            g.length -= t;
+          } else if (c > 1.0 - 1e-12) {
+            g.length += f.length;
+            f.length = 0.0;
+          }
+        }
+        if (f.length > snap) net.push_back(f);
+      }
+      std::erase_if(net, [&](const Face& f) { return f.length <= snap; });
+      e.faces = std::move(net);
+      if (e.faces.size() == 2) {
+        // Convex where the union is outside beyond the corner, along n0 - n1 (either order).
+        const P probe = e.x + 1e-3 * dx * (e.faces[0].normal - e.faces[1].normal);
+        e.convex = std::none_of(bodies.begin(), bodies.end(), [&](const PolygonBody& b) { return point_in_polygon(b, probe); });
+      }
+    }
+    std::erase_if(edge_nodes, [](const EdgeNode& e) { return e.merged; });
+  }
+  auto in_body = [](int body, const std::vector<int>& also, int b) {
+    return body == b || std::find(also.begin(), also.end(), b) != also.end();
+  };
+
   // Nodes: the boundary nodes, then the lattice vertices inside a body and clear of its boundary.
   struct NodeRecord {
     P x;
     int body = 0;
     int edge_node = -1;  // index into edge_nodes, -1 for a lattice vertex
     double volume = 0.0, mass = 0.0;
+    std::vector<int> also;  // other bodies it stands in (a seam)
   };
   std::vector<NodeRecord> nodes;
   const int vx = nx + 1, vy = ny + 1;
   std::vector<int> vertex_node(static_cast<std::size_t>(vx) * static_cast<std::size_t>(vy), -1);
   auto vertex_index = [&](int i, int j) { return static_cast<std::size_t>(j) * static_cast<std::size_t>(vx) + static_cast<std::size_t>(i); };
   for (std::size_t k = 0; k < edge_nodes.size(); ++k) {
-    nodes.push_back({edge_nodes[k].x, edge_nodes[k].body, static_cast<int>(k)});
+    nodes.push_back({edge_nodes[k].x, edge_nodes[k].body, static_cast<int>(k), 0.0, 0.0, edge_nodes[k].also});
     const double ti = (edge_nodes[k].x[0] - lat.origin[0]) / dx, tj = (edge_nodes[k].x[1] - lat.origin[1]) / dx;
     const double ri = std::round(ti), rj = std::round(tj);
     if (std::abs(ti - ri) * dx <= snap && std::abs(tj - rj) * dx <= snap) {
@@ -506,7 +576,7 @@ LatticeParticles<2> generate_polygon_particles(const std::vector<PolygonBody>& b
       const PolygonBody& body = bodies[static_cast<std::size_t>(b)];
       if (by_edge && (!point_in_polygon(body, x) || boundary_distance(body, x) < kInteriorClearance * dx)) continue;
       if (!by_edge && !point_in_polygon(body, x)) continue;
-      nodes.push_back({x, b, -1});
+      nodes.push_back({x, b, -1, 0.0, 0.0, {}});
       vertex_node[vertex_index(i, j)] = static_cast<int>(nodes.size() - 1);
     }
   }
@@ -532,7 +602,8 @@ LatticeParticles<2> generate_polygon_particles(const std::vector<PolygonBody>& b
         for (int i = ci - reach; i <= ci + reach; ++i) {
           if (i < 0 || i >= nx || j < 0 || j >= ny) continue;
           for (const int k : nodes_in_cell[lat.cell_index({i, j})]) {
-            if (nodes[static_cast<std::size_t>(k)].body != body) continue;
+            const NodeRecord& n = nodes[static_cast<std::size_t>(k)];
+            if (!in_body(n.body, n.also, body)) continue;
             const double d2 = (nodes[static_cast<std::size_t>(k)].x - x).squaredNorm();
             if (d2 < best_d2 || (d2 == best_d2 && k < best)) {
               best_d2 = d2;
@@ -557,7 +628,8 @@ LatticeParticles<2> generate_polygon_particles(const std::vector<PolygonBody>& b
       const int corners[4] = {vertex_node[vertex_index(i, j)], vertex_node[vertex_index(i + 1, j)],
                               vertex_node[vertex_index(i, j + 1)], vertex_node[vertex_index(i + 1, j + 1)]};
       const bool whole = area[c] == cell_area && std::all_of(std::begin(corners), std::end(corners), [&](int k) {
-                           return k >= 0 && nodes[static_cast<std::size_t>(k)].body == b;
+                           return k >= 0 && in_body(nodes[static_cast<std::size_t>(k)].body,
+                                                    nodes[static_cast<std::size_t>(k)].also, b);
                          });
       if (whole) {
         const double quarter = cell_area / 4.0;
@@ -605,7 +677,7 @@ LatticeParticles<2> generate_polygon_particles(const std::vector<PolygonBody>& b
   BoundaryNodes<2>& bn = out.boundary;
   for (const std::size_t k : order) {
     const NodeRecord& n = nodes[k];
-    if (n.edge_node >= 0) {
+    if (n.edge_node >= 0 && !edge_nodes[static_cast<std::size_t>(n.edge_node)].faces.empty()) {
       const EdgeNode& e = edge_nodes[static_cast<std::size_t>(n.edge_node)];
       std::uint8_t faces = 0;
       std::array<double, 4> face_area{};

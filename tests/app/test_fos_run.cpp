@@ -3,13 +3,17 @@
 // within what so coarse a lattice resolves; and every error path (no strength to reduce, a
 // monitor that is missing, an unreduced run that does not stand, a bracket that does not close)
 // stops with its message or exit status and keeps the trials it ran. The load factor
-// (fos.mode = "load") on a tiny strip load against Prandtl, and its input errors.
+// (fos.mode = "load") on a tiny strip load against Prandtl, and its input errors. Trials run in
+// process: each leaves its history (trial_NN.csv) and its last state (trial_NN.vtu), no run
+// folder.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <map>
 #include <numbers>
 #include <sstream>
 #include <string>
@@ -109,14 +113,28 @@ TEST(FosRun, TinyCutBracketsTheLimitAnalysisValue) {
   // lattice is 10 cells tall; docs/fos.md gives the converged figures).
   EXPECT_GT(3.4 * lo, 2.83);
   EXPECT_LT(3.4 * hi, 4.00);
-  // Every trial kept, with its folder, history and classification; those on the search's path
-  // agree with the bracket.
+  // Every trial kept, with its history, last state and classification; those on the search's
+  // path agree with the bracket. A strength-reduction trial is judged over the hold after
+  // time.end (5 s): eight time scales sqrt(5 m / g) by default, in the rate-independent limit.
+  EXPECT_NEAR(j["monitor"]["hold_start"].get<double>(), 5.0, 1e-12);
+  EXPECT_NEAR(j["monitor"]["hold"].get<double>(), 8.0 * std::sqrt(5.0 / 9.81), 1e-12);
+  EXPECT_TRUE(j["rate_independent"].get<bool>());
   ASSERT_GE(j["trials"].size(), j["trials_used"].get<std::size_t>());
   EXPECT_EQ(j["trials"][0]["factor"], 1.0);
   EXPECT_EQ(j["trials"][0]["outcome"], "stable");
   for (const auto& t : j["trials"]) {
-    EXPECT_TRUE(fs::exists(out / t["folder"].get<std::string>() / "summary.json"));
     EXPECT_TRUE(fs::exists(out / t["history"].get<std::string>()));
+    EXPECT_TRUE(fs::exists(out / t["frame"].get<std::string>())) << t;
+    EXPECT_FALSE(t["reduced"].contains("material.fluidity")) << "fluidity is set, not reduced";
+    const std::string outcome = t["outcome"];
+    if (outcome == "stable") {
+      // A trial stands at the end of its hold (the step that reaches it: within one step, dt =
+      // 0.9 dx / c_p = 3.7 ms), or collapses as soon as u_c passes 0.05 L.
+      const double end = 5.0 + 8.0 * std::sqrt(5.0 / 9.81);
+      EXPECT_GE(t["t_end"].get<double>(), end - 1e-9);
+      EXPECT_LT(t["t_end"].get<double>(), end + 4e-3);
+      EXPECT_LT(t["hold"]["ratio"].get<double>(), 0.95);
+    }
     if (!t["used"]) continue;
     const double tf = t["factor"];
     EXPECT_EQ(t["stable"].get<bool>(), tf <= lo) << tf;
@@ -229,8 +247,21 @@ end = 1.0
   // At F = 1.1 the dilatancy (20 deg) stays below phi_F (27.7 deg).
   for (const auto& [k, x] : s.values(1.1)) v[k] = x;
   EXPECT_DOUBLE_EQ(v.at("materials.soil.dilatancy"), 20.0);
-  // The overrides give a case the reader accepts.
-  EXPECT_NO_THROW((void)read_case<2>(load_case_document(file, s.overrides(3.0))));
+  // The case at F = 3, written into its document: the reader accepts it, with the reduced
+  // values and the rate-independent limit of every reduced material (the elastic one untouched).
+  CaseDocument doc = load_case_document(file, {});
+  s.apply(doc.table, 3.0);
+  EXPECT_DOUBLE_EQ(doc.table["materials"]["soil"]["cohesion"].value<double>().value(), 10.0e3 / 3.0);
+  EXPECT_EQ(doc.table["materials"]["soil"]["fluidity"].value<double>(), std::numeric_limits<double>::infinity());
+  EXPECT_EQ(doc.table["materials"]["clay"]["fluidity"].value<double>(), std::numeric_limits<double>::infinity());
+  EXPECT_FALSE(doc.table["materials"]["rock"]["fluidity"]);
+  EXPECT_NO_THROW((void)read_case<2>(doc));
+  // fos.rate_independent = false keeps the case's fluidity.
+  fos::StrengthReduction kept = s;
+  kept.rate_independent = false;
+  CaseDocument doc_kept = load_case_document(file, {});
+  kept.apply(doc_kept.table, 3.0);
+  EXPECT_EQ(doc_kept.table["materials"]["soil"]["fluidity"].value<double>(), 1.0);
 }
 
 TEST(FosRun, MonitorMissingOrOffTheBody) {
@@ -254,7 +285,20 @@ TEST(FosRun, MonitorMissingOrOffTheBody) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("is not on the body"), std::string::npos) << e.what();
   }
-  o.overrides = {"fos.window=6.0"};
+  // The load factor's window is not a key of strength reduction, whose trials are judged over
+  // the hold after time.end.
+  o.overrides = {"fos.window=1.0"};
+  try {
+    run_fos(o);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("fos.window"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("fos.hold"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("cut.toml"), std::string::npos) << e.what();
+  }
+  o.overrides = {"fos.hold=-1.0"};
+  EXPECT_THROW(run_fos(o), InputError);
+  o.overrides = {"fos.rate_independent=1"};
   EXPECT_THROW(run_fos(o), InputError);
   o.overrides = {"fos.typo=1"};
   EXPECT_THROW(run_fos(o), InputError);
@@ -274,7 +318,7 @@ TEST(FosRun, UnreducedRunThatCollapses) {
   EXPECT_TRUE(j["factor_of_safety"].is_null());
   ASSERT_EQ(j["trials"].size(), 1u);
   EXPECT_NE(j["trials"][0]["outcome"], "stable");
-  EXPECT_TRUE(fs::exists(out / "trial_01" / "probes.csv"));
+  EXPECT_TRUE(fs::exists(out / "trial_01.csv"));
 }
 
 TEST(FosRun, BracketThatDoesNotCloseKeepsItsTrials) {
@@ -289,13 +333,13 @@ TEST(FosRun, BracketThatDoesNotCloseKeepsItsTrials) {
   EXPECT_EQ(j["bracket"][0], 1.0);
   EXPECT_EQ(j["bracket"][1], 1.25);
   EXPECT_EQ(j["trials"].size(), 2u);
-  EXPECT_TRUE(fs::exists(out / "trial_02" / "summary.json"));
+  EXPECT_TRUE(fs::exists(out / "trial_02.csv"));
   // A second search into the same folder replaces the first one's trials.
   o.max_trials = 12;
   o.overrides = {"geometry.spacing=1.0", "material.cohesion=10000"};
   o.jobs = 1;
   EXPECT_EQ(run_fos(o), kExitNoFactor);
-  EXPECT_FALSE(fs::exists(out / "trial_02"));
+  EXPECT_FALSE(fs::exists(out / "trial_02.csv"));
 }
 
 // A weightless von Mises block, 3 m x 1.5 m at dx = 0.25 m, under a smooth rigid strip footing
@@ -397,20 +441,21 @@ TEST(FosRun, LoadFactorOfATinyStripLoadBracketsPrandtl) {
   }
   // Why the case reads the stress points' kinetic energy (its comment, docs/fos.md): at the end
   // of the standing trial F = 1 the nodes' energy is still a large part of its peak, the stress
-  // points' has died away.
-  std::ifstream energy(out / "trial_01" / "energy.csv");
-  std::string line, last;
-  std::getline(energy, line);
-  ASSERT_NE(line.find(",kinetic_stress_points"), std::string::npos) << line;
+  // points' has died away (trial_01.csv: both, and the one the classification read).
+  std::ifstream history(out / "trial_01.csv");
+  std::string line;
+  std::getline(history, line);
+  ASSERT_EQ(line, "t,u_c,kinetic,kinetic_nodes,kinetic_stress_points,plastic_dissipation");
   double peak_nodes = 0.0, peak_sp = 0.0, end_nodes = 0.0, end_sp = 0.0;
-  while (std::getline(energy, line)) {
+  while (std::getline(history, line)) {
     std::vector<double> row;
     std::stringstream cells(line);
     std::string cell;
     while (std::getline(cells, cell, ',')) row.push_back(std::stod(cell));
-    ASSERT_EQ(row.size(), 9u) << line;  // ... kinetic_stress_points, plastic_dissipation, stabilisation_loss
-    end_nodes = row[1];
-    end_sp = row[6];
+    ASSERT_EQ(row.size(), 6u) << line;
+    EXPECT_EQ(row[2], row[4]) << "the classification reads the stress points' energy";
+    end_nodes = row[3];
+    end_sp = row[4];
     peak_nodes = std::max(peak_nodes, end_nodes);
     peak_sp = std::max(peak_sp, end_sp);
   }
@@ -470,11 +515,9 @@ TEST(FosRun, LoadFactorInputErrors) {
                      "unknown kinetic energy 'fluid': \"auto\", \"nodes\" or \"stress_points\"");
   expect_input_error("mode = \"load\"", "mode = \"strength\"",
                      "the time functions of the loads are scaled only with mode = \"load\"");
-  // A trial reaches the function through --set functions.NAME.scale, split at dots.
-  expect_input_error_after({{"[functions.load]", "[functions.\"lo.ad\"]"},
-                            {"force = { y = \"load\" }", "force = { y = \"lo.ad\" }"},
-                            {"load_functions = [\"load\"]", "load_functions = [\"lo.ad\"]"}},
-                           {"the function name 'lo.ad' has a dot", "load_functions"});
+  // Keys of strength reduction are refused in load mode, naming the key.
+  expect_input_error("length = 1.0", "length = 1.0\nhold = 2.0", "fos.hold");
+  expect_input_error("length = 1.0", "length = 1.0\nrate_independent = false", "fos.rate_independent");
   // An all-elastic body has no strength to reduce, but its load can be scaled: the search then
   // never sees a collapse and says so (exit status 5), after the trials it was allowed.
   std::string elastic = kStripLoad;

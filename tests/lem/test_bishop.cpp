@@ -218,6 +218,75 @@ TEST(SoilGeometry, TwoTouchingBlocksActAsOne) {
   EXPECT_DOUBLE_EQ(two.soil_above(5.0, -1.0), 10.0);
 }
 
+// A layered column: each body's length above the base times its own unit weight, the later
+// body where two overlap; the base takes the soil of the body it lies in (the upper at a seam).
+TEST(SoilGeometry, LayersWeighAndStrengthenByTheirOwnSoil) {
+  Body lower, upper, lens;
+  lower.outer = {{0.0, 0.0}, {20.0, 0.0}, {20.0, 4.0}, {0.0, 4.0}};
+  lower.soil = Soil{10.0e3, 0.3, 20.0e3};
+  upper.outer = {{0.0, 4.0}, {20.0, 4.0}, {20.0, 10.0}, {0.0, 10.0}};
+  upper.soil = Soil{5.0e3, 0.1, 16.0e3};
+  lens.outer = {{8.0, 6.0}, {12.0, 6.0}, {12.0, 7.0}, {8.0, 7.0}};  // inside `upper`, listed later
+  lens.soil = Soil{1.0e3, 0.0, 22.0e3};
+  const Soil fallback{99.0, 0.9, 1.0};
+  const SoilGeometry g({lower, upper, lens}, {base_at(0.0)});
+  EXPECT_TRUE(g.layered());
+  EXPECT_DOUBLE_EQ(g.weight_above(5.0, 1.0, fallback), 3.0 * 20.0e3 + 6.0 * 16.0e3) << "no lens at x = 5";
+  EXPECT_DOUBLE_EQ(g.weight_above(10.0, 1.0, fallback), 3.0 * 20.0e3 + 5.0 * 16.0e3 + 1.0 * 22.0e3);
+  EXPECT_DOUBLE_EQ(g.weight_above(10.0, 6.5, fallback), 0.5 * 22.0e3 + 3.0 * 16.0e3);
+  EXPECT_DOUBLE_EQ(g.soil_at({5.0, 2.0}, fallback).cohesion, 10.0e3);
+  EXPECT_DOUBLE_EQ(g.soil_at({5.0, 4.0}, fallback).cohesion, 5.0e3);  // on the seam: the upper
+  EXPECT_DOUBLE_EQ(g.soil_at({10.0, 6.5}, fallback).cohesion, 1.0e3);
+  EXPECT_DOUBLE_EQ(g.soil_at({30.0, 6.5}, fallback).cohesion, 99.0);  // outside: the fallback
+  // Bodies without a soil of their own take the one given.
+  Body plain = lower;
+  plain.soil.reset();
+  const SoilGeometry h({plain}, {});
+  EXPECT_FALSE(h.layered());
+  EXPECT_DOUBLE_EQ(h.weight_above(5.0, 1.0, fallback), 3.0);
+}
+
+// A weak layer in the block cut: slices whose bases lie in it take its c and phi, all slices
+// weigh the layer with its own unit weight. Checked against eq. (9.2) summed over the returned
+// slices with the soils set by hand, and against the homogeneous cut (a weaker layer with the
+// same weight lowers F; the same soil in both bodies gives the homogeneous F).
+TEST(Bishop, ALayerSetsTheStrengthOfTheBasesInIt) {
+  const Soil soil{10.0e3, 20.0 * kPi / 180.0, 20.0e3};
+  const Soil weak{4.0e3, 10.0 * kPi / 180.0, 20.0e3};
+  const Circle circle{{24.0, 16.0}, 16.0};
+  Body below, layer, above;
+  below.outer = {{0.0, 0.0}, {20.0, 0.0}, {20.0, 2.0}, {0.0, 2.0}};
+  layer.outer = {{0.0, 2.0}, {20.0, 2.0}, {20.0, 4.0}, {0.0, 4.0}};
+  above.outer = {{0.0, 4.0}, {20.0, 4.0}, {20.0, 10.0}, {0.0, 10.0}};
+  below.soil = above.soil = soil;
+  layer.soil = soil;
+  const std::vector<RigidRegion> rigid{base_at(0.0), wall_at(0.0)};
+  BishopOptions o;
+  o.tolerance = 1e-13;
+  const CircleResult same = evaluate_circle(SoilGeometry({below, layer, above}, rigid), soil, circle, o);
+  const CircleResult homogeneous = evaluate_circle(block_cut(), soil, circle, o);
+  ASSERT_TRUE(same.valid() && homogeneous.valid());
+  EXPECT_NEAR(same.factor, homogeneous.factor, 1e-12);
+  layer.soil = weak;
+  const CircleResult r = evaluate_circle(SoilGeometry({below, layer, above}, rigid), soil, circle, o, true);
+  ASSERT_TRUE(r.valid()) << rejection_name(r.rejection);
+  EXPECT_LT(r.factor, homogeneous.factor - 0.02);
+  std::size_t in_layer = 0;
+  double resisting = 0.0, driving = 0.0;
+  for (const Slice& s : r.slices) {
+    const bool weak_base = s.base_y >= 2.0 && s.base_y < 4.0;
+    in_layer += weak_base ? 1 : 0;
+    const Soil& at = weak_base ? weak : soil;
+    EXPECT_DOUBLE_EQ(s.cohesion, at.cohesion) << s.x;
+    EXPECT_NEAR(s.weight, 20.0e3 * s.width * s.height, 1e-6 * s.weight);
+    const double t = std::tan(at.friction_angle);
+    resisting += (at.cohesion * s.width + s.weight * t) / (std::cos(s.alpha) + std::sin(s.alpha) * t / r.factor);
+    driving += s.weight * std::sin(s.alpha);
+  }
+  EXPECT_GT(in_layer, 3u);
+  EXPECT_NEAR(resisting / driving, r.factor, 1e-9 * r.factor);
+}
+
 TEST(SoilGeometry, SectionsSkipHoles) {
   Body b;
   b.outer = {{0.0, 0.0}, {10.0, 0.0}, {10.0, 10.0}, {0.0, 10.0}};

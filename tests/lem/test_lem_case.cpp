@@ -162,14 +162,29 @@ fluidity = 1.0
   error_of(geo + typo + kGravity, "materials.soil");
 }
 
-TEST(LemCase, TwoDifferentSoilsAreRefused) {
+// Bodies of different materials each carry their own soil (a layered slope).
+TEST(LemCase, EachBodyCarriesItsMaterialsSoil) {
   std::string two = "[geometry]\ndimension = 2\nspacing = 0.5\n[[geometry.block]]\nmin = [0.0, 0.0]\nmax = [10.0, "
                     "5.0]\nmaterial = \"soil\"\n[[geometry.block]]\nmin = [10.0, 0.0]\nmax = [20.0, 10.0]\nmaterial = "
                     "\"stiff\"\n" +
                     kMohrCoulomb + kMohrCoulomb;
   two.replace(two.rfind("[materials.soil]"), 16, "[materials.stiff]");
   two.replace(two.rfind("cohesion = 10.0e3"), 17, "cohesion = 20.0e3");
-  EXPECT_NE(error_of(two + kGravity, "material").find("one soil"), std::string::npos);
+  two.replace(two.rfind("density = 2000.0"), 16, "density = 1800.0");
+  const LemProblem p = read(two + kGravity);
+  ASSERT_EQ(p.geometry.bodies().size(), 2u);
+  EXPECT_TRUE(p.geometry.layered());
+  const auto& a = p.geometry.bodies()[0];
+  const auto& b = p.geometry.bodies()[1];
+  ASSERT_TRUE(a.soil && b.soil);
+  EXPECT_EQ(a.material, "soil");
+  EXPECT_EQ(b.material, "stiff");
+  EXPECT_DOUBLE_EQ(a.soil->cohesion, 10.0e3);
+  EXPECT_DOUBLE_EQ(b.soil->cohesion, 20.0e3);
+  EXPECT_DOUBLE_EQ(a.soil->unit_weight, 20.0e3);
+  EXPECT_DOUBLE_EQ(b.soil->unit_weight, 18.0e3);
+  // One material: one soil, not layered.
+  EXPECT_FALSE(read(polygon(kSlope) + kMohrCoulomb + kGravity).geometry.layered());
 }
 
 // The command: lem.json with F and the critical circle; a bad case exits 2 with one line.

@@ -70,6 +70,71 @@ TEST(Polygon, AnLOnTheLatticeIsItsTwoBlocks) {
   expect_same_particles(blocks, poly);
 }
 
+// Layers: polygons touching along lattice lines are the blocks of their materials (a seam node
+// takes the lattice's material and both densities' mass, and lies on no face), and a layered
+// slope sums to its area with the face's normal where a seam meets it.
+TEST(Polygon, LayersOnTheLatticeAreTheirBlocks) {
+  Block<2> a, b, c;
+  a.min = Vec<2>(0, 0);
+  a.max = Vec<2>(4, 1.5);
+  b.min = Vec<2>(0, 1.5);
+  b.max = Vec<2>(4, 2.5);
+  b.material = 1;
+  c.min = Vec<2>(4, 0);
+  c.max = Vec<2>(5, 2.5);
+  c.material = 2;
+  const std::vector<double> densities{2000.0, 1500.0, 2500.0};
+  const auto blocks = generate_lattice<2>({a, b, c}, 0.5, Vec<2>(0, 0), densities);
+  auto rect = [](const Block<2>& k) {
+    PolygonBody p = body_of({k.min, Vec<2>(k.max[0], k.min[1]), k.max, Vec<2>(k.min[0], k.max[1])});
+    p.material = k.material;
+    return p;
+  };
+  const auto poly = generate_polygon_particles({rect(a), rect(b), rect(c)}, 0.5, Vec<2>(0, 0), densities);
+  expect_same_particles(blocks, poly);
+  EXPECT_EQ(blocks.stress_points.material, poly.stress_points.material);
+}
+
+TEST(Polygon, ALayeredSlopeSumsToItsAreaWithTheFaceNormalAtTheSeams) {
+  // The 2:1 face y = x/2 from (0, 0) to (8, 4), a layer from y = 1 to 1.5 (lattice lines at 0.25).
+  PolygonBody lower = body_of({Vec<2>(0, 0), Vec<2>(12, 0), Vec<2>(12, 1), Vec<2>(2, 1)});
+  PolygonBody layer = body_of({Vec<2>(2, 1), Vec<2>(12, 1), Vec<2>(12, 1.5), Vec<2>(3, 1.5)});
+  PolygonBody upper = body_of({Vec<2>(3, 1.5), Vec<2>(12, 1.5), Vec<2>(12, 4), Vec<2>(8, 4)});
+  layer.material = 1;
+  const double dx = 0.25;
+  const auto d = generate_polygon_particles({lower, layer, upper}, dx, Vec<2>(0, 0), {2000.0, 1800.0});
+  const double area = 12.0 * 4.0 - 0.5 * 8.0 * 4.0;
+  EXPECT_NEAR(volume_sum(d.nodes), area, 1e-12 * area);
+  EXPECT_NEAR(volume_sum(d.stress_points), area, 1e-12 * area);
+  const Vec<2> n = Vec<2>(-1.0, 2.0).normalized();
+  int seam_face_nodes = 0;
+  for (std::size_t k = 0; k < d.boundary.size(); ++k) {
+    const Vec<2> x = d.nodes.position[static_cast<std::size_t>(d.boundary.node[k])];
+    // No boundary node inside the union: on a seam only where it meets the face or the side.
+    if (std::abs(x[1] - 1.0) < 1e-12 || std::abs(x[1] - 1.5) < 1e-12) {
+      EXPECT_TRUE(std::abs(x[1] - 0.5 * x[0]) < 1e-12 || std::abs(x[0] - 12.0) < 1e-12) << x.transpose();
+      if (std::abs(x[0] - 12.0) < 1e-12) {
+        EXPECT_EQ(d.boundary.faces[k], 0b0010);  // +x only
+        EXPECT_NEAR(d.boundary.area[k][1], dx, 1e-12);
+      } else {
+        ++seam_face_nodes;
+        EXPECT_EQ(d.boundary.condition[k], FaceCondition::normal);
+        EXPECT_NEAR((d.boundary.normal[k] - n).norm(), 0.0, 1e-14);
+      }
+    }
+  }
+  EXPECT_EQ(seam_face_nodes, 2);
+  // Nodes of the layer's material: its interior row and the seam y = 1.5 on it (a seam node
+  // takes the body below, the lattice's rule).
+  for (std::size_t i = 0; i < d.nodes.position.size(); ++i) {
+    const Vec<2> x = d.nodes.position[i];
+    if (x[0] > 4.0 && x[0] < 11.9) {
+      const bool weak = x[1] > 1.01 && x[1] < 1.51;
+      EXPECT_EQ(d.nodes.material[i], weak ? 1 : 0) << x.transpose();
+    }
+  }
+}
+
 // Checks that hold for any polygon: volumes, boundary nodes, normals, tributary lengths, spacing.
 void check_discretisation(const PolygonBody& body, double dx) {
   const auto d = generate_polygon_particles({body}, dx, Vec<2>(0, 0), {2000.0});
