@@ -260,8 +260,8 @@ CaseReport validate_case09(const Options& opt, const std::string& dir) {
   const std::string stiff = fmt::format(
       "open: the run completes (the gradient floor of method-notes eq. (3.2.6) keeps the nose's operators bounded) "
       "and the column collapses (wall below h0), but the deposit stops short and steep (front {:.1f} m against x_f = "
-      "{:.1f} m). With the hourglass control (method-notes §2.6) the front reaches 0.78 x_f at dx = 0.25 m (the "
-      "simple scheme, a viscosity of order rho c_p dx: 0.64-0.69) and the steepest slope is 4.5 times c / (rho g h) "
+      "{:.1f} m). With the hourglass control (method-notes §2.6) the front reaches 0.84 x_f at dx = 0.25 m (the "
+      "simple scheme, a viscosity of order rho c_p dx: 0.64-0.69) and the steepest slope is 5.9 times c / (rho g h) "
       "(simple: 6-8): the nose is a few particles thick, where a cohesion of 1/50 of gamma H is resolved by one or two "
       "particles and the corrected operators' truncation error, not the cohesion, sets the slope it stands at",
       front, xf);
