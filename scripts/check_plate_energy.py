@@ -47,8 +47,15 @@ def main():
     probes = read(os.path.join(a.out, "probes.csv"))
     t_p = [float(r["t"]) for r in probes]
     uy = [float(r["tip.uy"]) for r in probes]
-    # Maxima of the tip's upward deflection (the mode starts moving up).
-    peaks = [t_p[i] for i in range(1, len(uy) - 1) if uy[i] > 0.0 and uy[i] > uy[i - 1] and uy[i] >= uy[i + 1]]
+    # Maxima of the tip's upward deflection (the mode starts moving up): above half the largest,
+    # and at least half a reference period apart (a finer plate carries higher-mode ripple).
+    top = max(uy)
+    peaks = []
+    for i in range(1, len(uy) - 1):
+        if uy[i] > 0.5 * top and uy[i] > uy[i - 1] and uy[i] >= uy[i + 1]:
+            if peaks and t_p[i] - peaks[-1] < 0.5 * a.period:
+                continue
+            peaks.append(t_p[i])
     if len(peaks) < 2:
         sys.exit("fewer than two maxima of the tip's deflection in {} s: no period to measure".format(t_p[-1]))
 
