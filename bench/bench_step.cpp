@@ -24,6 +24,7 @@
 #include "materials/lode_form.hpp"
 #include "materials/perzyna.hpp"
 #include "materials/perzyna_models.hpp"
+#include "materials/tensor.hpp"
 #include "materials/yield_cam_clay.hpp"
 #include "materials/yield_drucker_prager.hpp"
 #include "materials/yield_mohr_coulomb.hpp"
@@ -610,21 +611,6 @@ struct ReturnTrials {
   double tau = 2.5e-4;
 };
 
-Sym6 principal_turned(double p, double q, double theta, double turn) {
-  const double d[3] = {2.0 * q / 3.0 * std::sin(theta + 2.0 * std::numbers::pi / 3.0), 2.0 * q / 3.0 * std::sin(theta),
-                       2.0 * q / 3.0 * std::sin(theta - 2.0 * std::numbers::pi / 3.0)};
-  const double c = std::cos(turn), s = std::sin(turn), cx = std::cos(0.7 * turn), sx = std::sin(0.7 * turn);
-  const double R[3][3] = {{c, -s * cx, s * sx}, {s, c * cx, -c * sx}, {0.0, sx, cx}};
-  double m[3][3];
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) {
-      m[i][j] = 0.0;
-      for (int k = 0; k < 3; ++k) m[i][j] += R[i][k] * d[k] * R[j][k];
-    }
-  }
-  return {m[0][0] - p, m[1][1] - p, m[2][2] - p, m[0][1], m[1][2], m[0][2]};
-}
-
 ReturnTrials return_trials(bool cam_clay, std::size_t count) {
   ReturnTrials t;
   std::uint64_t seed = 12345;
@@ -649,7 +635,7 @@ ReturnTrials return_trials(bool cam_clay, std::size_t count) {
       const double R = Y + std::sqrt(3.0) * 0.5 * p;
       q = over * std::sqrt(R * R - dF * dF) / K;
     }
-    t.stress.push_back(principal_turned(p, q, theta, turn));
+    t.stress.push_back(tensor::from_invariants(p, q, theta, turn));
   }
   return t;
 }

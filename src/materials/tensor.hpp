@@ -3,6 +3,7 @@
 // TENSOR shear components). A double contraction counts each shear component twice.
 #include <array>
 #include <cmath>
+#include <numbers>
 
 #include "core/types.hpp"
 
@@ -38,6 +39,25 @@ inline double determinant(const Sym6& a) {
 inline double equivalent_strain(const Sym6& eps) {
   const Sym6 e = deviator(eps);
   return std::sqrt(2.0 / 3.0 * ddot(e, e));
+}
+
+/// The stress of mean stress -p, deviator q and Lode angle theta (0 in shear, pi/6 in triaxial
+/// compression), its principal axes turned away from x, y, z by R = Rz(turn) Rx(0.7 turn):
+/// R diag(s1, s2, s3) R^T - p 1. For checks and benchmarks of the returns on general states.
+inline Sym6 from_invariants(double p, double q, double theta, double turn) {
+  constexpr double third = 2.0 * std::numbers::pi / 3.0;
+  const double d[3] = {2.0 * q / 3.0 * std::sin(theta + third), 2.0 * q / 3.0 * std::sin(theta),
+                       2.0 * q / 3.0 * std::sin(theta - third)};
+  const double c = std::cos(turn), s = std::sin(turn), cx = std::cos(0.7 * turn), sx = std::sin(0.7 * turn);
+  const double R[3][3] = {{c, -s * cx, s * sx}, {s, c * cx, -c * sx}, {0.0, sx, cx}};
+  double m[3][3];
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      m[i][j] = 0.0;
+      for (int k = 0; k < 3; ++k) m[i][j] += R[i][k] * d[k] * R[j][k];
+    }
+  }
+  return {m[0][0] - p, m[1][1] - p, m[2][2] - p, m[0][1], m[1][2], m[0][2]};
 }
 
 }  // namespace rktsph::tensor

@@ -104,21 +104,7 @@ struct CamClaySurface {
   /// Q_p = M^2 (2p' - p_c)/p_c, Q_q = 2q/p_c, the flow() above; F with its tension guard.
   PQForm pq(double p, double q, double Y) const {
     PQForm f;
-    const double M2 = M_c * M_c;
-    if (p <= kTensionGuard * Y) {
-      f.F = p;
-      f.F_p = 1.0;
-    } else {
-      f.F = p + q * q / (M2 * p);
-      f.F_p = 1.0 - q * q / (M2 * p * p);
-      f.F_q = 2.0 * q / (M2 * p);
-    }
-    f.Q_p = M2 * (2.0 * p - Y) / Y;
-    f.Q_q = 2.0 * q / Y;
-    f.Q_pp = 2.0 * M2 / Y;
-    f.Q_qq = 2.0 / Y;
-    f.Q_pY = -2.0 * M2 * p / (Y * Y);
-    f.Q_qY = -2.0 * q / (Y * Y);
+    pq_parts(M_c * M_c, p, q, Y, f);
     return f;
   }
 
@@ -138,6 +124,21 @@ struct CamClaySurface {
     }
     LodeForm f;
     const double M2 = M * M;
+    pq_parts(M2, p, q, Y, f);
+    if (p > kTensionGuard * Y) f.F_theta = -2.0 * q * q * dM / (M2 * M * p);
+    const double ell = p * (p - Y);  // f = q^2 + M^2 p'(p' - p_c)
+    f.Q_theta = 2.0 * M * dM * ell / Y;
+    f.Q_ptheta = 2.0 * M * dM * (2.0 * p - Y) / Y;
+    f.Q_thetatheta = 2.0 * (dM * dM + M * d2M) * ell / Y;
+    f.Q_thetaY = -2.0 * M * dM * p * p / (Y * Y);
+    return f;
+  }
+
+ private:
+  /// The (p', q) parts of pq() and pq_theta() at a given M^2: F with its tension guard, the flow
+  /// Q_p, Q_q and their derivatives along p', q and the size Y (method-notes eq. (2.5.8)).
+  template <class Form>
+  static void pq_parts(double M2, double p, double q, double Y, Form& f) {
     if (p <= kTensionGuard * Y) {
       f.F = p;
       f.F_p = 1.0;
@@ -145,21 +146,16 @@ struct CamClaySurface {
       f.F = p + q * q / (M2 * p);
       f.F_p = 1.0 - q * q / (M2 * p * p);
       f.F_q = 2.0 * q / (M2 * p);
-      f.F_theta = -2.0 * q * q * dM / (M2 * M * p);
     }
-    const double ell = p * (p - Y);  // f = q^2 + M^2 p'(p' - p_c)
     f.Q_p = M2 * (2.0 * p - Y) / Y;
     f.Q_q = 2.0 * q / Y;
-    f.Q_theta = 2.0 * M * dM * ell / Y;
     f.Q_pp = 2.0 * M2 / Y;
-    f.Q_ptheta = 2.0 * M * dM * (2.0 * p - Y) / Y;
     f.Q_qq = 2.0 / Y;
-    f.Q_thetatheta = 2.0 * (dM * dM + M * d2M) * ell / Y;
     f.Q_pY = -2.0 * M2 * p / (Y * Y);
     f.Q_qY = -2.0 * q / (Y * Y);
-    f.Q_thetaY = -2.0 * M * dM * p * p / (Y * Y);
-    return f;
   }
+
+ public:
 
   /// sin(phi_c) -> M_c in triaxial compression (docs/cases.md §1.2 C3).
   static double M_from_friction_angle(double phi_deg) {

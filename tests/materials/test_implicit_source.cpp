@@ -339,21 +339,7 @@ constexpr double kDeg = std::numbers::pi / 180.0;
 // A stress of mean -p, size q and Lode angle theta (eq. (1.1.3), tension positive: +30 deg is
 // triaxial compression), its principal axes turned away from x, y, z by `turn` radians.
 Sym6 stress_of(double p, double q, double theta, double turn = 0.4) {
-  const double s1 = 2.0 * q / 3.0 * std::sin(theta + 2.0 * std::numbers::pi / 3.0);
-  const double s2 = 2.0 * q / 3.0 * std::sin(theta);
-  const double s3 = 2.0 * q / 3.0 * std::sin(theta - 2.0 * std::numbers::pi / 3.0);
-  // R = Rz(turn) Rx(0.7 turn) applied to diag(s1, s2, s3): R diag R^T.
-  const double c = std::cos(turn), s = std::sin(turn), cx = std::cos(0.7 * turn), sx = std::sin(0.7 * turn);
-  const double R[3][3] = {{c, -s * cx, s * sx}, {s, c * cx, -c * sx}, {0.0, sx, cx}};
-  const double d[3] = {s1, s2, s3};
-  double m[3][3];
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) {
-      m[i][j] = 0.0;
-      for (int k = 0; k < 3; ++k) m[i][j] += R[i][k] * d[k] * R[j][k];
-    }
-  }
-  return {m[0][0] - p, m[1][1] - p, m[2][2] - p, m[0][1], m[1][2], m[0][2]};
+  return tensor::from_invariants(p, q, theta, turn);
 }
 
 double lode_sin3(const Sym6& sigma) {

@@ -148,8 +148,8 @@ namespace {
 // sideways, under V2's default step, free: once their particles are within a kernel's reach they
 // are one continuum (there is no contact between deformable bodies). The run must complete
 // (the simple scheme's blew up, issue 49). The total momentum is not kept: it is printed
-// (docs/VALIDATION.md, "V2's default step": 4.8 times the initial over 0.6 s, 0.1 with the
-// free-surface detection off, 9 with the simple scheme): the corrected operators are not
+// (docs/VALIDATION.md, "V2's default step": 4.8 times the initial over 0.6 s; with the test
+// edited, 0.1 with the free-surface detection off, 9 with the simple scheme): the corrected operators are not
 // pair-antisymmetric (method-notes §3.2) and the faces that meet across a gap narrower than the
 // kernel's reach are flagged and made traction-free while the other body's stress points still
 // act on them.
